@@ -1,0 +1,55 @@
+//! Compiles the C++ shims (one translation unit per library, so OpenVDB users never parse CGAL
+//! headers) and links the Debian packages behind them.
+
+use std::path::Path;
+
+const INSTALL_HINT: &str = "run `bash scripts/install-deps.sh` (Debian bookworm: libopenvdb-dev, libcgal-dev, libtbb-dev, libgmp-dev, libmpfr-dev, libeigen3-dev)";
+
+fn require_header(name: &str) {
+    let dirs = ["/usr/include", "/usr/local/include", "/usr/include/x86_64-linux-gnu", "/usr/include/aarch64-linux-gnu"];
+    if !dirs.iter().any(|d| Path::new(d).join(name).exists()) {
+        panic!("latvox: missing C++ header <{name}>; {INSTALL_HINT}");
+    }
+}
+
+fn main() {
+    require_header("openvdb/openvdb.h");
+    require_header("CGAL/Surface_mesh.h");
+    require_header("tbb/tbb.h");
+    require_header("gmp.h");
+    require_header("mpfr.h");
+
+    let flags = |b: &mut cc::Build| {
+        b.std("c++17")
+            .flag_if_supported("-O2")
+            .flag_if_supported("-Wno-unused-parameter")
+            .flag_if_supported("-Wno-deprecated-declarations")
+            .flag_if_supported("-Wno-class-memaccess")
+            .include("cpp")
+            .include("/usr/include/eigen3");
+    };
+
+    let mut vdb = cxx_build::bridge("src/ffi/vdb.rs");
+    flags(&mut vdb);
+    vdb.file("cpp/vdb.cc").compile("latvox_vdb");
+
+    let mut cgal = cxx_build::bridge("src/ffi/cgal.rs");
+    flags(&mut cgal);
+    cgal.define("CGAL_LINKED_WITH_TBB", None)
+        .file("cpp/cgal.cc")
+        .compile("latvox_cgal");
+
+    for lib in ["openvdb", "tbb", "Imath-3_1", "gmp", "mpfr"] {
+        println!("cargo:rustc-link-lib={lib}");
+    }
+    for f in [
+        "src/ffi/vdb.rs",
+        "src/ffi/cgal.rs",
+        "cpp/vdb.h",
+        "cpp/vdb.cc",
+        "cpp/cgal.h",
+        "cpp/cgal.cc",
+    ] {
+        println!("cargo:rerun-if-changed={f}");
+    }
+}

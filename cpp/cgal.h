@@ -1,0 +1,13 @@
+// CGAL side of the bridge: closed-mesh measures and validity checks on an indexed triangle soup.
+#pragma once
+#include <cstdint>
+#include "rust/cxx.h"
+
+namespace latvox {
+
+struct CgalReport;
+
+CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
+                      bool self_intersection);
+
+}  // namespace latvox

@@ -1,0 +1,5 @@
+//! Where Rust calls C++: one bridge per library (OpenVDB, CGAL), each compiled as its own
+//! translation unit. Nothing here is public; safe wrappers live in `grid` and `verify`.
+
+pub(crate) mod cgal;
+pub(crate) mod vdb;

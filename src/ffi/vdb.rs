@@ -1,0 +1,33 @@
+//! The OpenVDB half of the C++ bridge. Raw declarations only; `crate::grid` wraps them safely.
+
+#[cxx::bridge(namespace = "latvox")]
+pub(crate) mod ffi {
+    unsafe extern "C++" {
+        include!("latvox/cpp/vdb.h");
+
+        type VdbGrid;
+
+        fn vdb_set_threads(threads: usize);
+        fn vdb_grid_from_leaves(
+            voxel_size: f64,
+            origin: &[f64],
+            half_width: f32,
+            leaf_origins: &[i32],
+            values: &[f32],
+        ) -> Result<UniquePtr<VdbGrid>>;
+        fn vdb_volume_to_mesh(
+            grid: &VdbGrid,
+            adaptivity: f64,
+            positions: &mut Vec<f32>,
+            indices: &mut Vec<u32>,
+        ) -> Result<()>;
+        fn vdb_active_voxels(grid: &VdbGrid) -> u64;
+        fn vdb_leaf_count(grid: &VdbGrid) -> u64;
+        fn vdb_memory_bytes(grid: &VdbGrid) -> u64;
+        fn vdb_write(grid: &VdbGrid, path: &str) -> Result<()>;
+    }
+}
+
+// SAFETY: an OpenVDB grid is immutable once built here; const methods are thread-safe.
+unsafe impl Send for ffi::VdbGrid {}
+unsafe impl Sync for ffi::VdbGrid {}

@@ -1,0 +1,18 @@
+//! latvox: implicit descriptions of additive-manufacturing parts (TPMS lattices first) to
+//! printable, verified meshes. Rust samples fields and orchestrates; OpenVDB holds the sparse
+//! level sets and meshes them; CGAL verifies the result.
+//!
+//! Stages, one module each: [`field`] → [`grid`] → [`mesh`] → [`verify`] → [`stl`] (output).
+//! Capabilities: [`tpms`].
+
+pub mod error;
+pub(crate) mod ffi;
+pub mod field;
+pub mod grid;
+pub mod mesh;
+pub mod output;
+pub mod stl;
+pub mod tpms;
+pub mod verify;
+
+pub use error::{Error, Result};

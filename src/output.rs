@@ -1,0 +1,46 @@
+//! Atomic output: write to a temporary file in the destination folder, then rename over the
+//! target. A run that fails midway leaves no file behind, and never a half-written one.
+
+use crate::error::{Error, Result};
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+/// Checks up front that `path` can be created (its folder exists and is writable), so a long
+/// job fails before doing its work rather than after.
+pub fn check_writable(path: &Path) -> Result<()> {
+    let dir = parent_dir(path);
+    if path.is_dir() {
+        return Err(Error::invalid(format!("{}: is a directory", path.display())));
+    }
+    tempfile::Builder::new()
+        .prefix(".latvox-probe-")
+        .tempfile_in(dir)
+        .map(drop)
+        .map_err(|e| Error::io(path, e))
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// Writes `path` atomically through `body`.
+pub fn write_atomic(
+    path: &Path,
+    body: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<()> {
+    let dir = parent_dir(path);
+    let tmp = tempfile::Builder::new()
+        .prefix(".latvox-")
+        .tempfile_in(dir)
+        .map_err(|e| Error::io(path, e))?;
+    {
+        let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file());
+        body(&mut w).map_err(|e| Error::io(path, e))?;
+        w.flush().map_err(|e| Error::io(path, e))?;
+    }
+    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    Ok(())
+}

@@ -1,0 +1,60 @@
+//! Verification by CGAL: closedness, outward orientation, self-intersection, volume and area,
+//! computed by CGAL's Polygon Mesh Processing on a Surface_mesh built from our triangles —
+//! an independent second measurement of every mesh latvox writes.
+
+use crate::error::{Error, Result};
+use crate::ffi::cgal::ffi;
+use crate::mesh::Mesh;
+
+/// What CGAL found.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Verification {
+    /// The triangles formed an oriented 2-manifold as given (no non-manifold edge or vertex).
+    pub manifold: bool,
+    /// No boundary edge.
+    pub closed: bool,
+    /// Closed and oriented with normals pointing out.
+    pub outward: bool,
+    /// Whether the self-intersection test ran.
+    pub self_intersection_checked: bool,
+    /// Some pair of non-adjacent triangles intersects.
+    pub self_intersecting: bool,
+    /// Enclosed volume, mm³ (`null` when the mesh is not closed).
+    pub volume: Option<f64>,
+    /// Surface area, mm².
+    pub area: f64,
+    pub faces: u64,
+    pub vertices: u64,
+    pub border_edges: u64,
+    pub components: u64,
+}
+
+impl Verification {
+    /// A valid closed outward solid with no self-intersection.
+    pub fn is_valid_solid(&self) -> bool {
+        self.manifold
+            && self.closed
+            && self.outward
+            && self.self_intersection_checked
+            && !self.self_intersecting
+    }
+}
+
+/// Runs CGAL's checks on `mesh`. `self_intersection` turns on the (costlier) intersection test.
+pub fn verify(mesh: &Mesh, self_intersection: bool) -> Result<Verification> {
+    let r = ffi::cgal_check(&mesh.positions, &mesh.indices, self_intersection)
+        .map_err(|e| Error::backend("CGAL mesh check", e))?;
+    Ok(Verification {
+        manifold: r.valid_polygon_mesh,
+        closed: r.closed,
+        outward: r.outward,
+        self_intersection_checked: r.self_intersection_checked,
+        self_intersecting: r.self_intersecting,
+        volume: r.volume.is_finite().then_some(r.volume),
+        area: r.area,
+        faces: r.faces,
+        vertices: r.vertices,
+        border_edges: r.border_edges,
+        components: r.components,
+    })
+}

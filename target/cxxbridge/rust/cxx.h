@@ -1,0 +1,1 @@
+/root/.cargo/registry/src/index.crates.io-1949cf8c6b5b557f/cxx-1.0.205/include/cxx.h
