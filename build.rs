@@ -6,7 +6,12 @@ use std::path::Path;
 const INSTALL_HINT: &str = "run `bash scripts/install-deps.sh` (Debian bookworm: libopenvdb-dev, libcgal-dev, libtbb-dev, libgmp-dev, libmpfr-dev, libeigen3-dev)";
 
 fn require_header(name: &str) {
-    let dirs = ["/usr/include", "/usr/local/include", "/usr/include/x86_64-linux-gnu", "/usr/include/aarch64-linux-gnu"];
+    let dirs = [
+        "/usr/include",
+        "/usr/local/include",
+        "/usr/include/x86_64-linux-gnu",
+        "/usr/include/aarch64-linux-gnu",
+    ];
     if !dirs.iter().any(|d| Path::new(d).join(name).exists()) {
         panic!("latvox: missing C++ header <{name}>; {INSTALL_HINT}");
     }

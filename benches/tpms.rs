@@ -1,1 +1,144 @@
-fn main() {}
+//! TPMS benchmarks, with the figures quoted in README.
+//!
+//! 1. The main job at scale: 10×10×10 gyroid cells, net, density 0.30, 32 voxels per cell (a
+//!    320³ grid), run as the `latvox` binary writing its STL: wall time and peak resident memory
+//!    (the child's own `ru_maxrss`, from wait4), median of several runs.
+//! 2. Calibration alone, for every type and structure at density 0.30, in a fresh process each
+//!    (so the per-process sample tables are built inside the timing, as a CLI run pays them).
+//!
+//! Run: `cargo bench --bench tpms` (add `-- --runs N` to change the repeat count).
+
+use std::process::Command;
+use std::time::Instant;
+
+fn run_measured(cmd: &mut Command) -> (f64, f64, i32) {
+    let start = Instant::now();
+    let child = cmd.spawn().expect("spawn latvox");
+    let pid = child.id() as libc::pid_t;
+    let mut status = 0;
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: plain wait4 on our own child; `usage` is a valid out-pointer.
+    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    assert_eq!(r, pid, "wait4 failed");
+    let secs = start.elapsed().as_secs_f64();
+    std::mem::forget(child);
+    let code = if libc::WIFEXITED(status) {
+        libc::WEXITSTATUS(status)
+    } else {
+        -1
+    };
+    (secs, usage.ru_maxrss as f64 / 1024.0, code)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let runs = args
+        .iter()
+        .position(|a| a == "--runs")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3usize);
+    let exe = env!("CARGO_BIN_EXE_latvox");
+    let dir = tempfile::tempdir().unwrap();
+    let threads = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    println!("machine: {threads} threads; {runs} runs per case, median reported");
+
+    for (label, extra) in [
+        (
+            "full pipeline (CGAL checks incl. self-intersection)",
+            vec![],
+        ),
+        (
+            "without the self-intersection test",
+            vec!["--no-self-intersection-check"],
+        ),
+    ] {
+        let mut walls = Vec::new();
+        let mut rss = Vec::new();
+        let out = dir.path().join("g10.stl");
+        let report = dir.path().join("g10.json");
+        for _ in 0..runs {
+            let mut c = Command::new(exe);
+            c.args([
+                "tpms",
+                "--type",
+                "gyroid",
+                "--structure",
+                "net",
+                "--density",
+                "0.3",
+            ])
+            .args([
+                "--cells",
+                "10",
+                "--cell-size",
+                "5",
+                "--resolution",
+                "32",
+                "--quiet",
+            ])
+            .arg("-o")
+            .arg(&out)
+            .arg("--report")
+            .arg(&report)
+            .args(&extra)
+            .stdout(std::process::Stdio::null());
+            let (s, m, code) = run_measured(&mut c);
+            assert_eq!(code, 0, "latvox failed");
+            walls.push(s);
+            rss.push(m);
+        }
+        let rep: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        println!(
+            "gyroid net 0.30, 10x10x10 cells, 320^3 grid, {label}: wall {:.2} s (median), peak RSS {:.0} MB; {} triangles, STL {:.0} MB, achieved density {:.5}",
+            median(walls),
+            median(rss),
+            rep["triangles"],
+            std::fs::metadata(&out).unwrap().len() as f64 / 1e6,
+            rep["achieved_density"].as_f64().unwrap()
+        );
+        println!("  stage times of the last run (s): {}", rep["timings"]);
+    }
+
+    println!("calibration alone (density 0.30, 32 voxels per cell, 3x3x3 cells, fresh process):");
+    let probe = std::path::Path::new(exe).with_file_name("latvox");
+    let _ = probe;
+    for t in ["p", "gyroid", "d", "iwp", "s", "frd", "neovius"] {
+        for st in ["net", "sheet"] {
+            let mut cal = Vec::new();
+            let report = dir.path().join("c.json");
+            for _ in 0..runs {
+                let mut c = Command::new(exe);
+                c.args(["tpms", "--type", t, "--structure", st, "--density", "0.3"])
+                    .args([
+                        "--cells",
+                        "3",
+                        "--cell-size",
+                        "5",
+                        "--quiet",
+                        "--allow-islands",
+                    ])
+                    .arg("-o")
+                    .arg(dir.path().join("c.stl"))
+                    .arg("--report")
+                    .arg(&report)
+                    .stdout(std::process::Stdio::null())
+                    .stderr(std::process::Stdio::null());
+                let (_, _, code) = run_measured(&mut c);
+                assert!(code == 0 || code == 1, "latvox failed on {t} {st}");
+                let rep: serde_json::Value =
+                    serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+                cal.push(rep["timings"]["calibrate"].as_f64().unwrap() * 1e3);
+            }
+            println!("  {t:8} {st:6} calibration {:.1} ms (median)", median(cal));
+        }
+    }
+}

@@ -15,8 +15,10 @@
 
 #include <array>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "latvox/src/ffi/cgal.rs.h"
@@ -27,41 +29,63 @@ namespace PMP = CGAL::Polygon_mesh_processing;
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Mesh = CGAL::Surface_mesh<K::Point_3>;
 
-CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
-                      bool self_intersection) {
+namespace {
+
+// Builds a Surface_mesh from an indexed soup. Returns false (with a repaired mesh) when the soup
+// is not an oriented 2-manifold as given.
+bool build_mesh(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
+                Mesh& mesh) {
   if (positions.size() % 3 != 0 || indices.size() % 3 != 0)
     throw std::invalid_argument("positions and indices must come in triples");
   const std::size_t nv = positions.size() / 3;
+  const std::size_t nf = indices.size() / 3;
+  for (std::size_t i = 0; i < indices.size(); ++i)
+    if (indices[i] >= nv) throw std::out_of_range("triangle index past the vertex list");
+  // Fast path: add faces one by one; Surface_mesh refuses any face that would make an edge or
+  // vertex non-manifold or flip against its neighbours.
+  mesh.reserve(nv, nf * 3 / 2 + 16, nf);
+  for (std::size_t i = 0; i < nv; ++i)
+    mesh.add_vertex(K::Point_3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]));
+  bool valid = true;
+  for (std::size_t f = 0; f < nf && valid; ++f) {
+    const auto a = Mesh::Vertex_index(indices[3 * f]);
+    const auto b = Mesh::Vertex_index(indices[3 * f + 1]);
+    const auto c = Mesh::Vertex_index(indices[3 * f + 2]);
+    if (a == b || b == c || a == c || mesh.add_face(a, b, c) == Mesh::null_face()) valid = false;
+  }
+  if (valid) return true;
+  // Not an oriented 2-manifold as given: let CGAL duplicate non-manifold vertices and
+  // reorient, so the mesh can still be measured.
+  mesh.clear();
   std::vector<K::Point_3> points;
   points.reserve(nv);
   for (std::size_t i = 0; i < nv; ++i)
     points.emplace_back(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
   std::vector<std::array<std::size_t, 3>> polygons;
-  polygons.reserve(indices.size() / 3);
-  for (std::size_t i = 0; i < indices.size(); i += 3) {
-    if (indices[i] >= nv || indices[i + 1] >= nv || indices[i + 2] >= nv)
-      throw std::out_of_range("triangle index past the vertex list");
-    polygons.push_back({indices[i], indices[i + 1], indices[i + 2]});
+  polygons.reserve(nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    const auto a = indices[3 * f], b = indices[3 * f + 1], c = indices[3 * f + 2];
+    if (a != b && b != c && a != c) polygons.push_back({a, b, c});
   }
-
-  CgalReport r{};
-  r.valid_polygon_mesh = PMP::is_polygon_soup_a_polygon_mesh(polygons);
-  if (!r.valid_polygon_mesh) {
-    // Duplicate non-manifold vertices and reorient so CGAL can still build and measure it.
-    PMP::orient_polygon_soup(points, polygons);
-  }
-  Mesh mesh;
+  PMP::orient_polygon_soup(points, polygons);
   PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
-  std::vector<K::Point_3>().swap(points);
-  std::vector<std::array<std::size_t, 3>>().swap(polygons);
+  return false;
+}
 
+}  // namespace
+
+CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
+                      bool self_intersection) {
+  CgalReport r{};
+  Mesh mesh;
+  r.valid_polygon_mesh = build_mesh(positions, indices, mesh);
   r.faces = mesh.number_of_faces();
   r.vertices = mesh.number_of_vertices();
   std::size_t border = 0;
   for (auto h : mesh.halfedges())
     if (mesh.is_border(h)) ++border;
   r.border_edges = border;
-  r.closed = CGAL::is_closed(mesh);
+  r.closed = border == 0;
   r.area = PMP::area(mesh);
   auto fcc = mesh.add_property_map<Mesh::Face_index, std::size_t>("f:cc").first;
   r.components = PMP::connected_components(mesh, fcc);
@@ -76,6 +100,23 @@ CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint
   r.self_intersecting =
       self_intersection && PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh);
   return r;
+}
+
+rust::Vec<uint32_t> cgal_self_intersections(rust::Slice<const float> positions,
+                                            rust::Slice<const uint32_t> indices,
+                                            std::size_t limit) {
+  Mesh mesh;
+  if (!build_mesh(positions, indices, mesh))
+    throw std::invalid_argument("face indices need an oriented 2-manifold mesh");
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
+  PMP::self_intersections<CGAL::Parallel_if_available_tag>(faces(mesh), mesh,
+                                                           std::back_inserter(pairs));
+  rust::Vec<uint32_t> out;
+  for (std::size_t i = 0; i < pairs.size() && i < limit; ++i) {
+    out.push_back(static_cast<uint32_t>(pairs[i].first));
+    out.push_back(static_cast<uint32_t>(pairs[i].second));
+  }
+  return out;
 }
 
 }  // namespace latvox

@@ -10,4 +10,8 @@ struct CgalReport;
 CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
                       bool self_intersection);
 
+rust::Vec<uint32_t> cgal_self_intersections(rust::Slice<const float> positions,
+                                            rust::Slice<const uint32_t> indices,
+                                            std::size_t limit);
+
 }  // namespace latvox

@@ -1,5 +1,4 @@
 use latvox::field::*;
-use latvox::grid::*;
 use latvox::tpms::*;
 use std::time::Instant;
 fn main() {
@@ -9,30 +8,53 @@ fn main() {
     let only: Option<String> = args.get(3).cloned();
     let a = 5.0;
     for s in Surface::ALL {
-        if let Some(o) = &only { if s.name() != o { continue; } }
+        if let Some(o) = &only {
+            if s.name() != o {
+                continue;
+            }
+        }
         for st in [Structure::Net, Structure::Sheet] {
+            let t0 = Instant::now();
+            let r = calibrate::feasible_range(s, st);
+            println!(
+                "{} {:?} feasible {:?} ({:?})",
+                s.name(),
+                st,
+                r,
+                t0.elapsed()
+            );
             for target in [0.1, 0.2, 0.3, 0.5] {
-                let t0 = Instant::now();
-                let t = calibrate::level_for(s, st, target);
-                let tc = t0.elapsed();
                 let h = a / res;
-                let bounds = Aabb { min: [0.0; 3], max: [a * cells; 3] };
-                let f = Intersection { a: TpmsField::new(s, st, t, [a; 3], [0.0; 3], 3.0 * h), b: bounds };
-                let spec = GridSpec::covering(&bounds, h, 3.0);
-                let t1 = Instant::now();
-                let g = Grid::sample(&f, spec).unwrap();
-                let ts = t1.elapsed();
-                let t2 = Instant::now();
-                let m = g.to_mesh(0.0).unwrap();
-                let tm = t2.elapsed();
+                let t0 = Instant::now();
+                let c = match calibrate::calibrate(s, st, target, [a; 3], h, [cells; 3], 0.0) {
+                    Ok(c) => c,
+                    Err(e) => {
+                        println!("   {target}: {e}");
+                        continue;
+                    }
+                };
+                let tc = t0.elapsed();
+                let bounds = Aabb {
+                    min: [0.0; 3],
+                    max: [a * cells; 3],
+                };
+                let l = Lattice {
+                    surface: s,
+                    structure: st,
+                    level: c.level,
+                    cell: [a; 3],
+                    bounds,
+                    phase: [0.0; 3],
+                };
+                let (m, ms) = l.mesh(h, 0.0).unwrap();
                 let vf = m.volume() / bounds.volume();
-                let es = m.edge_stats();
-                println!("{:8} {:?} target {target} level {t:.4} vf {vf:.5} err {:+.5} tris {} bnd {} nm {} mis {} cal {:?} samp {:?} mesh {:?}",
-                    s.name(), st, vf - target, m.triangle_count(), es.boundary, es.non_manifold, es.misoriented, tc, ts, tm);
-                if args.get(4).is_some() {
-                    let v = latvox::verify::verify(&m, true).unwrap();
-                    println!("   {:?}", v);
-                }
+                let wall = if st == Structure::Sheet {
+                    calibrate::thinnest_sheet_wall(s, c.level) * res
+                } else {
+                    f64::NAN
+                };
+                println!("   {target}: err {:+.5} pred {:+.5} analytic {:+.4}->{:+.4} wall {wall:.2}vox meshings {} cal {:?} kept {}",
+                    vf - target, c.predicted_fraction - target, c.analytic_level, c.level, c.meshings, tc, ms.snap.kept);
             }
         }
     }

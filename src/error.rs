@@ -20,7 +20,10 @@ pub enum Error {
     Format { path: PathBuf, message: String },
     /// OpenVDB or CGAL threw.
     #[error("{context}: {message}")]
-    Backend { context: &'static str, message: String },
+    Backend {
+        context: &'static str,
+        message: String,
+    },
 }
 
 impl Error {

@@ -17,6 +17,20 @@ pub trait Field: Sync {
     /// A lower bound on the distance from `p` to the surface `value = 0`.
     fn clearance(&self, p: Vec3) -> f64;
 
+    /// The implicit function and its gradient at `p`: any function with the same zero set and
+    /// sign as `value`, smooth near the surface (used for Newton projection onto the surface).
+    /// The default differentiates `value` numerically.
+    fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
+        let e = 1e-6 * (1.0 + p.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+        let g = [0, 1, 2].map(|a| {
+            let (mut up, mut dn) = (p, p);
+            up[a] += e;
+            dn[a] -= e;
+            (self.value(up) - self.value(dn)) / (2.0 * e)
+        });
+        (self.value(p), g)
+    }
+
     /// Values at the 8³ points `origin + h·(i, j, k)`, `i, j, k ∈ 0..8`, stored at
     /// `out[(i·8 + j)·8 + k]` (OpenVDB's leaf order). Fields with separable structure override
     /// this to share work along each axis.

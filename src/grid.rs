@@ -105,14 +105,9 @@ impl Grid {
         }
         let sampled = blocks.len() as u64;
         drop(blocks);
-        let inner = ffi::vdb_grid_from_leaves(
-            h,
-            &spec.origin,
-            spec.half_width as f32,
-            &origins,
-            &values,
-        )
-        .map_err(|e| Error::backend("building the OpenVDB grid", e))?;
+        let inner =
+            ffi::vdb_grid_from_leaves(h, &spec.origin, spec.half_width as f32, &origins, &values)
+                .map_err(|e| Error::backend("building the OpenVDB grid", e))?;
         Ok(Grid {
             inner,
             spec,

@@ -11,6 +11,8 @@ pub mod field;
 pub mod grid;
 pub mod mesh;
 pub mod output;
+pub mod progress;
+pub mod snap;
 pub mod stl;
 pub mod tpms;
 pub mod verify;

@@ -10,13 +10,31 @@ use std::path::Path;
 pub fn check_writable(path: &Path) -> Result<()> {
     let dir = parent_dir(path);
     if path.is_dir() {
-        return Err(Error::invalid(format!("{}: is a directory", path.display())));
+        return Err(Error::invalid(format!(
+            "{}: is a directory",
+            path.display()
+        )));
     }
     tempfile::Builder::new()
         .prefix(".latvox-probe-")
         .tempfile_in(dir)
         .map(drop)
         .map_err(|e| Error::io(path, e))
+}
+
+/// Ordinary file permissions (0666 less the umask), not the temporary file's private 0600.
+fn file_mode() -> std::fs::Permissions {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::Permissions::from_mode(0o666)
+    }
+    #[cfg(not(unix))]
+    {
+        std::fs::metadata(".")
+            .map(|m| m.permissions())
+            .unwrap_or_else(|_| unreachable!())
+    }
 }
 
 fn parent_dir(path: &Path) -> &Path {
@@ -34,6 +52,7 @@ pub fn write_atomic(
     let dir = parent_dir(path);
     let tmp = tempfile::Builder::new()
         .prefix(".latvox-")
+        .permissions(file_mode())
         .tempfile_in(dir)
         .map_err(|e| Error::io(path, e))?;
     {

@@ -39,7 +39,10 @@ fn write_binary(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
     use rayon::prelude::*;
     let n = mesh.triangle_count();
     let count = u32::try_from(n).map_err(|_| {
-        std::io::Error::new(std::io::ErrorKind::InvalidInput, "more than 2^32 triangles for binary STL")
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "more than 2^32 triangles for binary STL",
+        )
     })?;
     let mut header = [b' '; 80];
     let tag = b"binary STL written by latvox";
@@ -188,11 +191,16 @@ fn parse_ascii(data: &[u8]) -> std::result::Result<Mesh, String> {
                     .and_then(|s| s.parse::<f32>().ok())
                     .ok_or_else(|| format!("line {}: bad vertex", lineno + 1))?;
             }
-            let id = w.vertex(p).map_err(|e| format!("line {}: {e}", lineno + 1))?;
+            let id = w
+                .vertex(p)
+                .map_err(|e| format!("line {}: {e}", lineno + 1))?;
             w.mesh.indices.push(id);
             corners += 1;
         } else if word.eq_ignore_ascii_case("endloop") && corners % 3 != 0 {
-            return Err(format!("line {}: facet without exactly three vertices", lineno + 1));
+            return Err(format!(
+                "line {}: facet without exactly three vertices",
+                lineno + 1
+            ));
         }
     }
     if corners == 0 {

@@ -58,3 +58,11 @@ pub fn verify(mesh: &Mesh, self_intersection: bool) -> Result<Verification> {
         components: r.components,
     })
 }
+
+/// Up to `limit` pairs of intersecting triangles (indices into `mesh`), found by CGAL.
+/// Needs an oriented 2-manifold mesh (face indices are only meaningful then).
+pub fn self_intersections(mesh: &Mesh, limit: usize) -> Result<Vec<(u32, u32)>> {
+    let flat = ffi::cgal_self_intersections(&mesh.positions, &mesh.indices, limit)
+        .map_err(|e| Error::backend("CGAL self-intersection search", e))?;
+    Ok(flat.chunks_exact(2).map(|p| (p[0], p[1])).collect())
+}

@@ -27,5 +27,12 @@ pub(crate) mod ffi {
             indices: &[u32],
             self_intersection: bool,
         ) -> Result<CgalReport>;
+
+        /// Up to `limit` intersecting face pairs, flattened (face indices in input order).
+        fn cgal_self_intersections(
+            positions: &[f32],
+            indices: &[u32],
+            limit: usize,
+        ) -> Result<Vec<u32>>;
     }
 }

@@ -42,6 +42,15 @@ pub enum Structure {
     Sheet,
 }
 
+impl Structure {
+    pub fn name(self) -> &'static str {
+        match self {
+            Structure::Net => "net",
+            Structure::Sheet => "sheet",
+        }
+    }
+}
+
 impl Surface {
     pub const ALL: [Surface; 7] = [
         Surface::P,
@@ -247,8 +256,8 @@ impl TpmsField {
         clamp: f64,
     ) -> Self {
         let l = surface.lipschitz_per_axis();
-        let lipschitz = ((l[0] / cell[0]).powi(2) + (l[1] / cell[1]).powi(2) + (l[2] / cell[2]).powi(2))
-            .sqrt();
+        let lipschitz =
+            ((l[0] / cell[0]).powi(2) + (l[1] / cell[1]).powi(2) + (l[2] / cell[2]).powi(2)).sqrt();
         TpmsField {
             surface,
             structure,
@@ -278,7 +287,11 @@ impl TpmsField {
         ];
         let norm = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
         let v = self.implicit(f);
-        let d = if norm > 1e-12 { v / norm } else { v.signum() * self.clamp };
+        let d = if norm > 1e-12 {
+            v / norm
+        } else {
+            v.signum() * self.clamp
+        };
         d.clamp(-self.clamp, self.clamp)
     }
 
@@ -306,11 +319,24 @@ impl Field for TpmsField {
         self.implicit(self.raw(p)).abs() / self.lipschitz
     }
 
+    fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
+        let (f, g) = self.surface.eval(self.cell_coords(p));
+        let sign = match self.structure {
+            Structure::Net => 1.0,
+            Structure::Sheet => f.signum(),
+        };
+        (
+            self.implicit(f),
+            [0, 1, 2].map(|a| sign * g[a] / self.cell[a]),
+        )
+    }
+
     fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
         let mut tabs = [[AxisTable::default(); 8]; 3];
         for (a, tab) in tabs.iter_mut().enumerate() {
             for (i, t) in tab.iter_mut().enumerate() {
-                *t = AxisTable::at(TAU * (origin[a] + h * i as f64 - self.origin[a]) / self.cell[a]);
+                *t =
+                    AxisTable::at(TAU * (origin[a] + h * i as f64 - self.origin[a]) / self.cell[a]);
             }
         }
         let terms = self.surface.terms();
@@ -338,16 +364,22 @@ mod tests {
             Surface::P => -(c(x) + c(y) + c(z)),
             Surface::Gyroid => c(x) * sn(y) + c(y) * sn(z) + c(z) * sn(x),
             Surface::D => {
-                sn(x) * sn(y) * sn(z) + sn(x) * c(y) * c(z) + c(x) * sn(y) * c(z) + c(x) * c(y) * sn(z)
+                sn(x) * sn(y) * sn(z)
+                    + sn(x) * c(y) * c(z)
+                    + c(x) * sn(y) * c(z)
+                    + c(x) * c(y) * sn(z)
             }
             Surface::Iwp => {
-                2.0 * (c(x) * c(y) + c(y) * c(z) + c(z) * c(x)) - (c(2.0 * x) + c(2.0 * y) + c(2.0 * z))
+                2.0 * (c(x) * c(y) + c(y) * c(z) + c(z) * c(x))
+                    - (c(2.0 * x) + c(2.0 * y) + c(2.0 * z))
             }
             Surface::S => {
                 c(2.0 * x) * sn(y) * c(z) + c(x) * c(2.0 * y) * sn(z) + sn(x) * c(y) * c(2.0 * z)
             }
-            Surface::Frd => -(4.0 * c(x) * c(y) * c(z)
-                - (c(2.0 * x) * c(2.0 * y) + c(2.0 * y) * c(2.0 * z) + c(2.0 * z) * c(2.0 * x))),
+            Surface::Frd => {
+                -(4.0 * c(x) * c(y) * c(z)
+                    - (c(2.0 * x) * c(2.0 * y) + c(2.0 * y) * c(2.0 * z) + c(2.0 * z) * c(2.0 * x)))
+            }
             Surface::Neovius => 3.0 * (c(x) + c(y) + c(z)) + 4.0 * c(x) * c(y) * c(z),
         }
     }
@@ -356,7 +388,11 @@ mod tests {
         (0..50)
             .map(|i| {
                 let f = i as f64;
-                [(f * 0.137).fract(), (f * 0.311 + 0.05).fract(), (f * 0.713 + 0.3).fract()]
+                [
+                    (f * 0.137).fract(),
+                    (f * 0.311 + 0.05).fract(),
+                    (f * 0.713 + 0.3).fract(),
+                ]
             })
             .collect()
     }
@@ -382,7 +418,10 @@ mod tests {
                     up[a] += e;
                     dn[a] -= e;
                     let fd = (reference(s, up) - reference(s, dn)) / (2.0 * e);
-                    assert!((g[a] - fd).abs() < 1e-5 * (1.0 + fd.abs()), "{s:?} axis {a}");
+                    assert!(
+                        (g[a] - fd).abs() < 1e-5 * (1.0 + fd.abs()),
+                        "{s:?} axis {a}"
+                    );
                 }
             }
         }
@@ -403,14 +442,25 @@ mod tests {
 
     #[test]
     fn block_sampling_agrees_with_pointwise_values() {
-        let f = TpmsField::new(Surface::S, Structure::Sheet, 0.3, [5.0, 4.0, 6.0], [0.1, 0.2, 0.3], 1.0);
+        let f = TpmsField::new(
+            Surface::S,
+            Structure::Sheet,
+            0.3,
+            [5.0, 4.0, 6.0],
+            [0.1, 0.2, 0.3],
+            1.0,
+        );
         let mut block = [0.0f32; 512];
         let (o, h) = ([1.0, -2.0, 0.5], 0.13);
         f.sample_block(o, h, &mut block);
         for i in 0..8 {
             for j in 0..8 {
                 for k in 0..8 {
-                    let p = [o[0] + h * i as f64, o[1] + h * j as f64, o[2] + h * k as f64];
+                    let p = [
+                        o[0] + h * i as f64,
+                        o[1] + h * j as f64,
+                        o[2] + h * k as f64,
+                    ];
                     assert!((block[(i * 8 + j) * 8 + k] as f64 - f.value(p)).abs() < 1e-5);
                 }
             }

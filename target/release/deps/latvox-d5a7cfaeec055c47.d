@@ -1,8 +1,8 @@
-/work/main/target/release/deps/latvox-d5a7cfaeec055c47.d: src/lib.rs src/error.rs src/ffi/mod.rs src/ffi/cgal.rs src/ffi/vdb.rs src/field.rs src/grid.rs src/mesh.rs src/output.rs src/stl.rs src/tpms/mod.rs src/tpms/calibrate.rs src/tpms/surface.rs src/verify.rs
+/work/main/target/release/deps/latvox-d5a7cfaeec055c47.d: src/lib.rs src/error.rs src/ffi/mod.rs src/ffi/cgal.rs src/ffi/vdb.rs src/field.rs src/grid.rs src/mesh.rs src/output.rs src/progress.rs src/snap.rs src/stl.rs src/tpms/mod.rs src/tpms/calibrate.rs src/tpms/job.rs src/tpms/surface.rs src/verify.rs
 
-/work/main/target/release/deps/liblatvox-d5a7cfaeec055c47.rlib: src/lib.rs src/error.rs src/ffi/mod.rs src/ffi/cgal.rs src/ffi/vdb.rs src/field.rs src/grid.rs src/mesh.rs src/output.rs src/stl.rs src/tpms/mod.rs src/tpms/calibrate.rs src/tpms/surface.rs src/verify.rs
+/work/main/target/release/deps/liblatvox-d5a7cfaeec055c47.rlib: src/lib.rs src/error.rs src/ffi/mod.rs src/ffi/cgal.rs src/ffi/vdb.rs src/field.rs src/grid.rs src/mesh.rs src/output.rs src/progress.rs src/snap.rs src/stl.rs src/tpms/mod.rs src/tpms/calibrate.rs src/tpms/job.rs src/tpms/surface.rs src/verify.rs
 
-/work/main/target/release/deps/liblatvox-d5a7cfaeec055c47.rmeta: src/lib.rs src/error.rs src/ffi/mod.rs src/ffi/cgal.rs src/ffi/vdb.rs src/field.rs src/grid.rs src/mesh.rs src/output.rs src/stl.rs src/tpms/mod.rs src/tpms/calibrate.rs src/tpms/surface.rs src/verify.rs
+/work/main/target/release/deps/liblatvox-d5a7cfaeec055c47.rmeta: src/lib.rs src/error.rs src/ffi/mod.rs src/ffi/cgal.rs src/ffi/vdb.rs src/field.rs src/grid.rs src/mesh.rs src/output.rs src/progress.rs src/snap.rs src/stl.rs src/tpms/mod.rs src/tpms/calibrate.rs src/tpms/job.rs src/tpms/surface.rs src/verify.rs
 
 src/lib.rs:
 src/error.rs:
@@ -13,8 +13,11 @@ src/field.rs:
 src/grid.rs:
 src/mesh.rs:
 src/output.rs:
+src/progress.rs:
+src/snap.rs:
 src/stl.rs:
 src/tpms/mod.rs:
 src/tpms/calibrate.rs:
+src/tpms/job.rs:
 src/tpms/surface.rs:
 src/verify.rs:

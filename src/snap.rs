@@ -1,0 +1,247 @@
+//! Snap: moves each mesh vertex onto the exact surface it stands for.
+//!
+//! OpenVDB's volumeToMesh puts one vertex per voxel cell at the mean of the cell's edge
+//! crossings. That rounds every sharp edge (where the lattice meets its clipping box) and sits
+//! slightly off curved surfaces, and both bias the enclosed volume. Here, as in dual contouring,
+//! each vertex is moved to the exact feature its cell contains, and never out of its cell:
+//!
+//! * a cell crossed only by the field's surface: one Newton step onto `f = 0`;
+//! * a cell where the solid meets one or two clip planes: onto those planes, then along them
+//!   onto the curve or point where the surface meets them;
+//! * a box corner: onto the corner.
+//!
+//! A step that would leave the cell or the clip box is not taken (the vertex keeps the position
+//! OpenVDB gave it). Where the surface meets a clip plane at a grazing angle, snapping can still
+//! tip a sliver triangle through its neighbour: every triangle whose normal turned by more than
+//! [`MAX_TURN_DEGREES`] is found and its vertices are returned to OpenVDB's positions, repeatedly,
+//! until none is.
+
+use crate::field::{Aabb, Field, Vec3};
+use crate::grid::GridSpec;
+use crate::mesh::Mesh;
+use rayon::prelude::*;
+
+/// What the snap pass did, for the report.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct SnapStats {
+    /// Vertices moved onto the surface.
+    pub surface: u64,
+    /// Vertices moved onto a clip-plane/surface edge or a box corner.
+    pub edge: u64,
+    /// Vertices left where OpenVDB put them (the step would have left their cell).
+    pub kept: u64,
+    /// Vertices returned to OpenVDB's position because a triangle around them turned over.
+    pub restored: u64,
+}
+
+/// A triangle whose normal turns more than this in snapping is taken as folded.
+pub const MAX_TURN_DEGREES: f64 = 60.0;
+
+enum Outcome {
+    Surface,
+    Edge,
+    Kept,
+    Untouched,
+}
+
+/// Snaps the vertices of `mesh`, meshed from `surface ∩ clip` sampled on `spec`.
+pub fn snap(mesh: &mut Mesh, surface: &dyn Field, clip: &Aabb, spec: &GridSpec) -> SnapStats {
+    let original = mesh.positions.clone();
+    let outcomes: Vec<Outcome> = mesh
+        .positions
+        .par_chunks_exact_mut(3)
+        .map(|p| {
+            let v = [p[0] as f64, p[1] as f64, p[2] as f64];
+            let (out, w) = snap_vertex(v, surface, clip, spec);
+            if let Some(w) = w {
+                p[0] = w[0] as f32;
+                p[1] = w[1] as f32;
+                p[2] = w[2] as f32;
+            }
+            out
+        })
+        .collect();
+    let mut s = SnapStats::default();
+    for o in outcomes {
+        match o {
+            Outcome::Surface => s.surface += 1,
+            Outcome::Edge => s.edge += 1,
+            Outcome::Kept => s.kept += 1,
+            Outcome::Untouched => {}
+        }
+    }
+    s.restored = unfold(mesh, &original);
+    s
+}
+
+/// Returns to `original` the vertices of triangles that snapping turned by more than
+/// [`MAX_TURN_DEGREES`]; repeats until no triangle is turned. Returns how many were restored.
+pub fn unfold(mesh: &mut Mesh, original: &[f32]) -> u64 {
+    use crate::mesh::{cross, dot, norm, sub};
+    let cos_max = MAX_TURN_DEGREES.to_radians().cos();
+    let at = |pos: &[f32], i: u32| {
+        let i = 3 * i as usize;
+        [pos[i] as f64, pos[i + 1] as f64, pos[i + 2] as f64]
+    };
+    let normal = |pos: &[f32], t: &[u32]| {
+        let (a, b, c) = (at(pos, t[0]), at(pos, t[1]), at(pos, t[2]));
+        cross(sub(b, a), sub(c, a))
+    };
+    let mut restored = 0u64;
+    for _ in 0..8 {
+        let bad: Vec<u32> = mesh
+            .indices
+            .par_chunks_exact(3)
+            .filter(|t| {
+                let (n1, n0) = (normal(&mesh.positions, t), normal(original, t));
+                let (l1, l0) = (norm(n1), norm(n0));
+                l0 > 0.0 && (l1 == 0.0 || dot(n1, n0) < cos_max * l1 * l0)
+            })
+            .flat_map_iter(|t| t.to_vec())
+            .collect();
+        let mut changed = false;
+        for v in bad {
+            let i = 3 * v as usize;
+            if mesh.positions[i..i + 3] != original[i..i + 3] {
+                mesh.positions[i..i + 3].copy_from_slice(&original[i..i + 3]);
+                restored += 1;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    restored
+}
+
+fn snap_vertex(
+    v: Vec3,
+    surface: &dyn Field,
+    clip: &Aabb,
+    spec: &GridSpec,
+) -> (Outcome, Option<Vec3>) {
+    let h = spec.voxel;
+    // The dual cell holding v spans samples c..c+1 on each axis.
+    let c = [0, 1, 2].map(|a| ((v[a] - spec.origin[a]) / h - 0.5).floor());
+    let lo = [0, 1, 2].map(|a| spec.origin[a] + (c[a] + 0.5) * h);
+    // A moved vertex must stay in its cell (no fold-over) and in the clip box (the part's bounds).
+    let inside = |w: Vec3| {
+        (0..3).all(|a| {
+            w[a] >= lo[a] - 1e-3 * h
+                && w[a] <= lo[a] + h * (1.0 + 1e-3)
+                && w[a] >= clip.min[a]
+                && w[a] <= clip.max[a]
+        })
+    };
+
+    // Clip planes that pass through this cell.
+    let mut plane: [Option<f64>; 3] = [None; 3];
+    for a in 0..3 {
+        for p in [clip.min[a], clip.max[a]] {
+            if p > lo[a] && p < lo[a] + h {
+                plane[a] = Some(p);
+            }
+        }
+    }
+
+    if plane.iter().all(Option::is_none) {
+        return match newton(v, surface, [false; 3]) {
+            Some(w) if inside(w) => (Outcome::Surface, Some(w)),
+            _ => (Outcome::Kept, None),
+        };
+    }
+
+    // Which features produce the crossings on this cell's edges?
+    let corner = |i: usize| [0, 1, 2].map(|a| lo[a] + if i >> (2 - a) & 1 == 1 { h } else { 0.0 });
+    let mut fs = [0.0; 8];
+    let mut bs = [0.0; 8];
+    for (i, (f, b)) in fs.iter_mut().zip(bs.iter_mut()).enumerate() {
+        let q = corner(i);
+        *f = surface.value(q);
+        *b = clip.value(q);
+    }
+    let mut on_surface = false;
+    let mut on_plane = [false; 3];
+    for i in 0..8usize {
+        for a in 0..3 {
+            let j = i | (1 << (2 - a));
+            if j == i {
+                continue;
+            }
+            let (ci, cj) = (fs[i].max(bs[i]), fs[j].max(bs[j]));
+            if (ci < 0.0) == (cj < 0.0) {
+                continue;
+            }
+            let t = ci / (ci - cj);
+            let (qi, qj) = (corner(i), corner(j));
+            let q = [0, 1, 2].map(|k| qi[k] + t * (qj[k] - qi[k]));
+            let (f, b) = (surface.value(q), clip.value(q));
+            if f >= b {
+                on_surface = true;
+            } else {
+                // The box face active at q: the axis of largest outward offset.
+                let d = [0, 1, 2].map(|k| (clip.min[k] - q[k]).max(q[k] - clip.max[k]));
+                let k = (0..3).max_by(|&x, &y| d[x].total_cmp(&d[y])).unwrap();
+                on_plane[k] = true;
+            }
+        }
+    }
+    let planes: Vec<usize> = (0..3)
+        .filter(|&a| on_plane[a] && plane[a].is_some())
+        .collect();
+    if planes.is_empty() {
+        return match newton(v, surface, [false; 3]) {
+            Some(w) if on_surface && inside(w) => (Outcome::Surface, Some(w)),
+            _ => (Outcome::Kept, None),
+        };
+    }
+    let mut w = v;
+    let mut fixed = [false; 3];
+    for &a in &planes {
+        w[a] = plane[a].unwrap();
+        fixed[a] = true;
+    }
+    if on_surface && planes.len() < 3 {
+        match newton(w, surface, fixed) {
+            Some(x) if inside(x) => (Outcome::Edge, Some(x)),
+            _ => (Outcome::Kept, None),
+        }
+    } else if inside(w) {
+        (
+            if planes.len() == 3 {
+                Outcome::Edge
+            } else {
+                Outcome::Untouched
+            },
+            Some(w),
+        )
+    } else {
+        (Outcome::Kept, None)
+    }
+}
+
+/// Newton steps onto `f = 0`, moving only along the axes not `fixed`.
+fn newton(mut p: Vec3, field: &dyn Field, fixed: [bool; 3]) -> Option<Vec3> {
+    for _ in 0..4 {
+        let (f, mut g) = field.implicit_with_gradient(p);
+        for a in 0..3 {
+            if fixed[a] {
+                g[a] = 0.0;
+            }
+        }
+        let gg = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        if !(gg > 1e-20) {
+            return None;
+        }
+        let s = f / gg;
+        let step = [s * g[0], s * g[1], s * g[2]];
+        p = [p[0] - step[0], p[1] - step[1], p[2] - step[2]];
+        if (step[0] * step[0] + step[1] * step[1] + step[2] * step[2]).sqrt() < 1e-7 {
+            return Some(p);
+        }
+    }
+    let (f, g) = field.implicit_with_gradient(p);
+    let gn = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+    (f.abs() < 1e-5 * gn.max(1e-12)).then_some(p)
+}

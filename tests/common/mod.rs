@@ -1,0 +1,167 @@
+//! Test helpers that do not use latvox's own code: an STL reader, edge counting by hash map,
+//! volume by the divergence theorem, and the seed's TPMS formulas written out directly.
+#![allow(dead_code)]
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+pub fn latvox() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_latvox"))
+}
+
+pub fn run(args: &[&str], dir: &Path) -> Output {
+    latvox()
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run latvox")
+}
+
+/// Triangles as three corner positions each.
+pub type Tri = [[f64; 3]; 3];
+
+/// Reads a binary STL (checked against its size) or an ASCII STL.
+pub fn read_stl(path: &Path) -> Vec<Tri> {
+    let data = std::fs::read(path).unwrap();
+    if data.len() >= 84 {
+        let n = u32::from_le_bytes(data[80..84].try_into().unwrap()) as usize;
+        if data.len() == 84 + 50 * n {
+            return (0..n)
+                .map(|i| {
+                    let r = &data[84 + 50 * i..84 + 50 * (i + 1)];
+                    let f = |o: usize| f32::from_le_bytes(r[o..o + 4].try_into().unwrap()) as f64;
+                    [0, 1, 2].map(|k| [f(12 + 12 * k), f(16 + 12 * k), f(20 + 12 * k)])
+                })
+                .collect();
+        }
+    }
+    let text = String::from_utf8(data).expect("ASCII STL");
+    let verts: Vec<[f64; 3]> = text
+        .lines()
+        .filter_map(|l| {
+            let mut it = l.split_whitespace();
+            (it.next()? == "vertex").then(|| {
+                let v: Vec<f64> = it.map(|s| s.parse().unwrap()).collect();
+                [v[0], v[1], v[2]]
+            })
+        })
+        .collect();
+    verts.chunks(3).map(|c| [c[0], c[1], c[2]]).collect()
+}
+
+#[derive(Debug, Default, PartialEq, Eq)]
+pub struct Edges {
+    pub boundary: usize,
+    pub non_manifold: usize,
+    /// Edges used twice in the same direction (neighbours wound inconsistently).
+    pub same_direction: usize,
+}
+
+/// Edge incidences by exact vertex position (what a slicer sees).
+pub fn edges(tris: &[Tri]) -> Edges {
+    let key = |p: [f64; 3]| p.map(|x| (x as f32).to_bits());
+    let mut directed: HashMap<([u32; 3], [u32; 3]), usize> = HashMap::new();
+    for t in tris {
+        for k in 0..3 {
+            *directed
+                .entry((key(t[k]), key(t[(k + 1) % 3])))
+                .or_default() += 1;
+        }
+    }
+    let mut e = Edges::default();
+    let mut seen = std::collections::HashSet::new();
+    for (&(a, b), &n) in &directed {
+        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+        if !seen.insert((lo, hi)) {
+            continue;
+        }
+        let back = directed.get(&(b, a)).copied().unwrap_or(0);
+        let total = n + back;
+        if total == 1 {
+            e.boundary += 1;
+        } else if total > 2 {
+            e.non_manifold += 1;
+        } else if n == 2 || back == 2 {
+            e.same_direction += 1;
+        }
+    }
+    e
+}
+
+/// Signed volume by the divergence theorem.
+pub fn volume(tris: &[Tri]) -> f64 {
+    tris.iter()
+        .map(|[a, b, c]| {
+            (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                / 6.0
+        })
+        .sum()
+}
+
+pub fn bounds(tris: &[Tri]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for t in tris {
+        for p in t {
+            for a in 0..3 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+    }
+    (lo, hi)
+}
+
+/// The seed's formulas, with X = 2πx / a; returns F and its gradient in mm⁻¹.
+pub fn tpms(name: &str, p: [f64; 3], a: f64) -> (f64, [f64; 3]) {
+    let w = 2.0 * std::f64::consts::PI / a;
+    let f = |q: [f64; 3]| {
+        let (x, y, z) = (w * q[0], w * q[1], w * q[2]);
+        let (c, s) = (f64::cos, f64::sin);
+        match name {
+            "p" => -(c(x) + c(y) + c(z)),
+            "gyroid" => c(x) * s(y) + c(y) * s(z) + c(z) * s(x),
+            "d" => {
+                s(x) * s(y) * s(z) + s(x) * c(y) * c(z) + c(x) * s(y) * c(z) + c(x) * c(y) * s(z)
+            }
+            "iwp" => {
+                2.0 * (c(x) * c(y) + c(y) * c(z) + c(z) * c(x))
+                    - (c(2. * x) + c(2. * y) + c(2. * z))
+            }
+            "s" => c(2. * x) * s(y) * c(z) + c(x) * c(2. * y) * s(z) + s(x) * c(y) * c(2. * z),
+            "frd" => {
+                -(4.0 * c(x) * c(y) * c(z)
+                    - (c(2. * x) * c(2. * y) + c(2. * y) * c(2. * z) + c(2. * z) * c(2. * x)))
+            }
+            "neovius" => 3.0 * (c(x) + c(y) + c(z)) + 4.0 * c(x) * c(y) * c(z),
+            _ => panic!("unknown {name}"),
+        }
+    };
+    let e = 1e-6;
+    let g = [0, 1, 2].map(|k| {
+        let (mut u, mut d) = (p, p);
+        u[k] += e;
+        d[k] -= e;
+        (f(u) - f(d)) / (2.0 * e)
+    });
+    (f(p), g)
+}
+
+pub fn tempdir() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+pub fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+pub fn files_in(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    v.sort();
+    v
+}

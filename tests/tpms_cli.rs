@@ -1,0 +1,438 @@
+//! The `latvox tpms` and `latvox check` commands, run as a user runs them, checked with
+//! computations independent of latvox (see `common`) and with CGAL's verdict from the report.
+
+mod common;
+use common::*;
+
+const TYPES: [&str; 7] = ["p", "gyroid", "d", "iwp", "s", "frd", "neovius"];
+
+/// Every type × structure at the default resolution, 3×3×3 cells of 5 mm, density 0.30 (0.40 for
+/// the two nets that fall apart into islands below about 0.34: F-RD and Neovius):
+/// closed, manifold, consistently and outwardly wound, no self-intersection, exact density,
+/// bounding box equal to the box, every vertex on the surface or on the box.
+#[test]
+fn all_fourteen_lattices_are_closed_exact_and_on_their_surface() {
+    let dir = tempdir();
+    for ty in TYPES {
+        for st in ["net", "sheet"] {
+            let target = if st == "net" && (ty == "frd" || ty == "neovius") {
+                0.4
+            } else {
+                0.3
+            };
+            let density = target.to_string();
+            let stl = dir.path().join(format!("{ty}-{st}.stl"));
+            let rep = dir.path().join(format!("{ty}-{st}.json"));
+            let out = run(
+                &[
+                    "tpms",
+                    "--type",
+                    ty,
+                    "--structure",
+                    st,
+                    "--density",
+                    &density,
+                    "--cells",
+                    "3",
+                    "--cell-size",
+                    "5",
+                    "-q",
+                    "-o",
+                    stl.to_str().unwrap(),
+                    "--report",
+                    rep.to_str().unwrap(),
+                ],
+                dir.path(),
+            );
+            let ctx = format!("{ty} {st}: {}", String::from_utf8_lossy(&out.stderr));
+            assert_eq!(out.status.code(), Some(0), "{ctx}");
+            let r = json(&rep);
+            assert_eq!(r["resolution"], 32, "{ctx}");
+            let c = &r["checks"];
+            assert_eq!(c["closed"], true, "{ctx}");
+            assert_eq!(c["outward"], true, "{ctx}");
+            assert_eq!(c["manifold"], true, "{ctx}");
+            assert_eq!(c["self_intersection_checked"], true, "{ctx}");
+            assert_eq!(c["self_intersecting"], false, "{ctx}");
+            assert_eq!(c["border_edges"], 0, "{ctx}");
+
+            let tris = read_stl(&stl);
+            assert_eq!(tris.len() as u64, r["triangles"].as_u64().unwrap(), "{ctx}");
+            let e = edges(&tris);
+            assert_eq!(e, Edges::default(), "{ctx}");
+            let box_volume = 15.0f64.powi(3);
+            let vf = volume(&tris) / box_volume;
+            assert!((vf - target).abs() <= 0.002, "{ctx}: volume fraction {vf}");
+            let cgal_vf = r["achieved_density"].as_f64().unwrap();
+            assert!(
+                (cgal_vf - target).abs() <= 0.002,
+                "{ctx}: CGAL volume fraction {cgal_vf}"
+            );
+            assert!(
+                (cgal_vf - vf).abs() < 1e-4,
+                "{ctx}: CGAL {cgal_vf} vs divergence {vf}"
+            );
+
+            let h = r["voxel_size"].as_f64().unwrap();
+            let (lo, hi) = bounds(&tris);
+            for a in 0..3 {
+                assert!(
+                    lo[a].abs() <= h / 2.0 && (hi[a] - 15.0).abs() <= h / 2.0,
+                    "{ctx}: bounds {lo:?} {hi:?}"
+                );
+            }
+            let t = r["level"].as_f64().unwrap();
+            let mut worst: f64 = 0.0;
+            for tri in &tris {
+                for p in tri {
+                    let (f, g) = tpms(ty, *p, 5.0);
+                    let gn = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+                    let surf = if st == "net" {
+                        (f - t).abs()
+                    } else {
+                        (f.abs() - t).abs()
+                    } / gn;
+                    let face = (0..3)
+                        .map(|a| p[a].abs().min((p[a] - 15.0).abs()))
+                        .fold(f64::INFINITY, f64::min);
+                    worst = worst.max(surf.min(face));
+                }
+            }
+            assert!(
+                worst <= 0.5 * h,
+                "{ctx}: a vertex lies {worst} mm from surface and box (voxel {h})"
+            );
+        }
+    }
+}
+
+#[test]
+fn per_axis_cells_and_sizes_give_the_requested_box() {
+    let dir = tempdir();
+    let out = run(
+        &[
+            "tpms",
+            "-t",
+            "g",
+            "--cells",
+            "2,3,1",
+            "--cell-size",
+            "4,5,6",
+            "-d",
+            "0.25",
+            "-q",
+            "-o",
+            "a.stl",
+            "--report",
+            "a.json",
+        ],
+        dir.path(),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let tris = read_stl(&dir.path().join("a.stl"));
+    let (lo, hi) = bounds(&tris);
+    let want = [8.0, 15.0, 6.0];
+    for a in 0..3 {
+        assert!(
+            lo[a].abs() < 0.07 && (hi[a] - want[a]).abs() < 0.07,
+            "{lo:?} {hi:?}"
+        );
+    }
+    assert_eq!(edges(&tris), Edges::default());
+    let vf = volume(&tris) / (8.0 * 15.0 * 6.0);
+    assert!((vf - 0.25).abs() <= 0.002, "{vf}");
+
+    // Overall size with partial cells, placed at an origin.
+    let out = run(
+        &[
+            "tpms",
+            "-t",
+            "d",
+            "--size",
+            "12,11,7",
+            "--cell-size",
+            "5",
+            "--origin",
+            "10,-5,2",
+            "-q",
+            "-o",
+            "b.stl",
+        ],
+        dir.path(),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let tris = read_stl(&dir.path().join("b.stl"));
+    let (lo, hi) = bounds(&tris);
+    let (wlo, whi) = ([10.0, -5.0, 2.0], [22.0, 6.0, 9.0]);
+    for a in 0..3 {
+        assert!(
+            (lo[a] - wlo[a]).abs() < 0.08 && (hi[a] - whi[a]).abs() < 0.08,
+            "{lo:?} {hi:?}"
+        );
+    }
+    assert_eq!(edges(&tris), Edges::default());
+}
+
+#[test]
+fn ascii_output_reads_back_and_checks_clean() {
+    let dir = tempdir();
+    let out = run(
+        &[
+            "tpms",
+            "-t",
+            "n",
+            "--structure",
+            "sheet",
+            "--cells",
+            "2",
+            "--ascii",
+            "-q",
+            "-o",
+            "n.stl",
+        ],
+        dir.path(),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(dir.path().join("n.stl")).unwrap();
+    assert!(text.starts_with("solid") && text.trim_end().ends_with("endsolid latvox"));
+    let tris = read_stl(&dir.path().join("n.stl"));
+    assert_eq!(edges(&tris), Edges::default());
+
+    let out = run(&["check", "n.stl", "--json"], dir.path());
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["valid_solid"], true);
+    assert_eq!(v["triangles"].as_u64().unwrap() as usize, tris.len());
+    let cgal_volume = v["cgal"]["volume"].as_f64().unwrap();
+    assert!((cgal_volume - volume(&tris)).abs() < 1e-6 * cgal_volume.abs() + 1e-3);
+}
+
+#[test]
+fn check_finds_holes_flips_and_rejects_garbage() {
+    let dir = tempdir();
+    let out = run(
+        &[
+            "tpms", "-t", "p", "-d", "0.4", "--cells", "2", "-q", "-o", "p.stl",
+        ],
+        dir.path(),
+    );
+    assert_eq!(out.status.code(), Some(0));
+    let tris = read_stl(&dir.path().join("p.stl"));
+
+    let write = |name: &str, tris: &[Tri]| {
+        let mut b = vec![0u8; 80];
+        b.extend_from_slice(&(tris.len() as u32).to_le_bytes());
+        for t in tris {
+            b.extend_from_slice(&[0u8; 12]);
+            for p in t {
+                for x in p {
+                    b.extend_from_slice(&(*x as f32).to_le_bytes());
+                }
+            }
+            b.extend_from_slice(&[0, 0]);
+        }
+        std::fs::write(dir.path().join(name), b).unwrap();
+    };
+    // A hole: drop ten triangles.
+    write("holed.stl", &tris[10..]);
+    let out = run(&["check", "holed.stl", "--json"], dir.path());
+    assert_eq!(out.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["cgal"]["closed"], false);
+    let want = edges(&tris[10..]).boundary as u64;
+    assert_eq!(v["edges"]["boundary"].as_u64().unwrap(), want);
+    assert!(want > 0);
+
+    // Inside out: every triangle reversed.
+    let flipped: Vec<Tri> = tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    write("flipped.stl", &flipped);
+    let out = run(&["check", "flipped.stl", "--json"], dir.path());
+    assert_eq!(out.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["cgal"]["closed"], true);
+    assert_eq!(v["cgal"]["outward"], false);
+    assert!(v["cgal"]["volume"].as_f64().unwrap() < 0.0);
+
+    std::fs::write(
+        dir.path().join("junk.stl"),
+        b"\x00\x01garbage that is not an STL",
+    )
+    .unwrap();
+    let out = run(&["check", "junk.stl"], dir.path());
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr).trim().lines().count(),
+        1
+    );
+    let out = run(&["check", "missing.stl"], dir.path());
+    assert_eq!(out.status.code(), Some(2));
+}
+
+/// Bad arguments: exit code 2, one line on stderr, and no file left behind.
+#[test]
+fn bad_arguments_fail_cleanly_and_write_nothing() {
+    let dir = tempdir();
+    let sub = dir.path().join("a-directory");
+    std::fs::create_dir(&sub).unwrap();
+    let cases: Vec<Vec<&str>> = vec![
+        vec!["--density", "0"],
+        vec!["--density", "1"],
+        vec!["--density", "1.5"],
+        vec!["--density", "-0.1"],
+        vec!["--density", "abc"],
+        vec!["--cells", "0"],
+        vec!["--cells", "2,0,2"],
+        vec!["--cells", "2,2"],
+        vec!["--cell-size", "-5"],
+        vec!["--type", "schwartz"],
+        vec!["--structure", "lattice"],
+        vec!["--resolution", "0"],
+        vec!["--adaptivity", "2"],
+        vec!["-o", "/nonexistent-folder/x.stl"],
+        vec!["-o", "a-directory"],
+        vec!["--report", "/nonexistent-folder/r.json"],
+        vec!["--size", "10", "--cell-size", "5"],
+        vec!["--type", "p", "--density", "0.1"],
+        vec!["--type", "frd", "--structure", "sheet", "--density", "0.6"],
+        vec![
+            "--type",
+            "s",
+            "--structure",
+            "sheet",
+            "--density",
+            "0.1",
+            "--fixed-resolution",
+        ],
+    ];
+    for extra in cases {
+        let mut args = vec![
+            "tpms", "--cells", "1", "-q", "-o", "out.stl", "--report", "out.json",
+        ];
+        args.extend(extra.iter().copied());
+        let out = run(&args, dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{extra:?}: {err}");
+        assert!(err.starts_with("latvox: "), "{extra:?}: {err}");
+        assert_eq!(
+            files_in(dir.path()),
+            vec![sub.clone()],
+            "{extra:?} left files"
+        );
+        assert!(files_in(&sub).is_empty());
+    }
+    // The infeasible-density error names the range.
+    let out = run(
+        &["tpms", "--type", "p", "--density", "0.1", "-o", "x.stl"],
+        dir.path(),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("feasible range") && err.contains("0.214"),
+        "{err}"
+    );
+}
+
+#[test]
+fn help_teaches_with_examples() {
+    let out = latvox().args(["tpms", "--help"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let help = String::from_utf8_lossy(&out.stdout);
+    for needle in [
+        "Examples:",
+        "--density",
+        "--cells",
+        "--cell-size",
+        "--resolution",
+        "--adaptivity",
+        "--report",
+        "neovius",
+    ] {
+        assert!(help.contains(needle), "help lacks {needle}");
+    }
+    let out = latvox().output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn report_holds_every_field_and_progress_stays_off_pipes() {
+    let dir = tempdir();
+    let out = run(
+        &[
+            "tpms",
+            "-t",
+            "iwp",
+            "--structure",
+            "sheet",
+            "-d",
+            "0.2",
+            "--cells",
+            "2",
+            "-o",
+            "i.stl",
+            "--report",
+            "i.json",
+        ],
+        dir.path(),
+    );
+    assert_eq!(out.status.code(), Some(0));
+    // stderr is a pipe here: no spinner, no control characters.
+    assert!(!String::from_utf8_lossy(&out.stderr).contains('\u{1b}'));
+    let r = json(&dir.path().join("i.json"));
+    for key in [
+        "type",
+        "structure",
+        "level",
+        "target_density",
+        "achieved_density",
+        "triangles",
+        "vertices",
+        "area",
+        "volume",
+        "bounding_box",
+        "checks",
+        "timings",
+        "calibration",
+        "feasible_range",
+        "voxel_size",
+    ] {
+        assert!(!r[key].is_null(), "report lacks {key}");
+    }
+    for stage in [
+        "calibrate",
+        "sample",
+        "mesh",
+        "snap",
+        "verify",
+        "write",
+        "total",
+    ] {
+        assert!(r["timings"][stage].as_f64().unwrap() >= 0.0);
+    }
+    assert_eq!(r["type"], "iwp");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("achieved") && stdout.contains("closed yes"),
+        "{stdout}"
+    );
+}
