@@ -1,1 +1,0 @@
-../../../../release/build/latvox-e98d8e4114b085d6/out/cxxbridge/sources/latvox/src/ffi/vdb.rs.cc

@@ -1,1 +1,0 @@
-/root/.cargo/registry/src/index.crates.io-1949cf8c6b5b557f/cxx-1.0.205/include/cxx.h
