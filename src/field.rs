@@ -76,8 +76,8 @@ impl Field for Aabb {
     fn value(&self, p: Vec3) -> f64 {
         let mut outside = 0.0f64;
         let mut inside = f64::NEG_INFINITY;
-        for a in 0..3 {
-            let d = (self.min[a] - p[a]).max(p[a] - self.max[a]);
+        for (a, &pa) in p.iter().enumerate() {
+            let d = (self.min[a] - pa).max(pa - self.max[a]);
             outside += d.max(0.0).powi(2);
             inside = inside.max(d);
         }

@@ -231,7 +231,7 @@ fn newton(mut p: Vec3, field: &dyn Field, fixed: [bool; 3]) -> Option<Vec3> {
             }
         }
         let gg = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-        if !(gg > 1e-20) {
+        if gg.is_nan() || gg <= 1e-20 {
             return None;
         }
         let s = f / gg;

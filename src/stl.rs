@@ -196,7 +196,7 @@ fn parse_ascii(data: &[u8]) -> std::result::Result<Mesh, String> {
                 .map_err(|e| format!("line {}: {e}", lineno + 1))?;
             w.mesh.indices.push(id);
             corners += 1;
-        } else if word.eq_ignore_ascii_case("endloop") && corners % 3 != 0 {
+        } else if word.eq_ignore_ascii_case("endloop") && !corners.is_multiple_of(3) {
             return Err(format!(
                 "line {}: facet without exactly three vertices",
                 lineno + 1
@@ -206,7 +206,7 @@ fn parse_ascii(data: &[u8]) -> std::result::Result<Mesh, String> {
     if corners == 0 {
         return Err("ASCII STL with no facets".into());
     }
-    if corners % 3 != 0 {
+    if !corners.is_multiple_of(3) {
         return Err("ASCII STL ends inside a facet".into());
     }
     Ok(w.mesh)

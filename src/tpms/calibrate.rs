@@ -188,8 +188,8 @@ fn one_percolating_component(vals: &[f64], n: usize, member: &dyn Fn(f64) -> boo
         }
     }
     let mut root = None;
-    for a in 0..inside.len() {
-        if inside[a] {
+    for (a, &is_in) in inside.iter().enumerate() {
+        if is_in {
             let r = find(&mut parent, a as u32);
             match root {
                 None => root = Some(r),

@@ -125,10 +125,8 @@ pub struct Domain {
 impl Domain {
     /// Whole cells: `counts` cells of size `cell` per axis.
     pub fn from_cells(counts: [u32; 3], cell: Vec3, origin: Vec3) -> Result<Domain> {
-        for a in 0..3 {
-            if counts[a] == 0 {
-                return Err(Error::invalid("cell counts must be at least 1"));
-            }
+        if counts.contains(&0) {
+            return Err(Error::invalid("cell counts must be at least 1"));
         }
         Self::checked(cell, [0, 1, 2].map(|a| counts[a] as f64 * cell[a]), origin)
     }

@@ -1,0 +1,91 @@
+//! Pieces shared by the subcommands: option parsers, JSON output, summary formatting.
+//! Each subcommand lives in its own file and exposes `Args` (clap) and `run`.
+
+pub mod check;
+pub mod tpms;
+
+use latvox::Result;
+use std::path::Path;
+
+pub(crate) fn split3<T: Copy>(
+    s: &str,
+    parse: impl Fn(&str) -> std::result::Result<T, String>,
+) -> std::result::Result<[T; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    match parts.len() {
+        1 => {
+            let v = parse(parts[0])?;
+            Ok([v, v, v])
+        }
+        3 => Ok([parse(parts[0])?, parse(parts[1])?, parse(parts[2])?]),
+        _ => Err(format!(
+            "expected one value or three comma-separated values, got '{s}'"
+        )),
+    }
+}
+
+pub(crate) fn parse_f64(s: &str) -> std::result::Result<f64, String> {
+    s.parse::<f64>()
+        .map_err(|_| format!("'{s}' is not a number"))
+}
+
+pub(crate) fn parse_positive3(s: &str) -> std::result::Result<[f64; 3], String> {
+    split3(s, |p| {
+        let v = parse_f64(p)?;
+        if v > 0.0 && v.is_finite() {
+            Ok(v)
+        } else {
+            Err(format!("{p} must be a positive length in mm"))
+        }
+    })
+}
+
+pub(crate) fn parse_finite3(s: &str) -> std::result::Result<[f64; 3], String> {
+    split3(s, |p| {
+        let v = parse_f64(p)?;
+        v.is_finite()
+            .then_some(v)
+            .ok_or_else(|| format!("{p} must be finite"))
+    })
+}
+
+pub(crate) fn parse_counts(s: &str) -> std::result::Result<[u32; 3], String> {
+    split3(s, |p| match p.parse::<u32>() {
+        Ok(0) => Err("cell counts must be at least 1".to_string()),
+        Ok(v) => Ok(v),
+        Err(_) => Err(format!("'{p}' is not a whole number of cells")),
+    })
+}
+
+pub(crate) fn parse_density(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v > 0.0 && v < 1.0 {
+        Ok(v)
+    } else {
+        Err(format!("density must be strictly between 0 and 1, got {s}"))
+    }
+}
+
+pub(crate) fn parse_unit(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("must be in [0, 1], got {s}"))
+    }
+}
+
+pub(crate) fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
+    latvox::output::write_atomic(path, |w| {
+        serde_json::to_writer_pretty(&mut *w, value).map_err(std::io::Error::other)?;
+        w.write_all(b"\n")
+    })
+}
+
+pub(crate) fn yes(b: bool) -> &'static str {
+    if b {
+        "yes"
+    } else {
+        "NO"
+    }
+}

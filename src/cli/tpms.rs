@@ -1,0 +1,218 @@
+//! `latvox tpms`: a closed TPMS lattice at an exact volume fraction.
+
+use super::{
+    parse_counts, parse_density, parse_finite3, parse_positive3, parse_unit, write_json, yes,
+};
+use clap::Args;
+use latvox::stl::StlFormat;
+use latvox::tpms::{Domain, Structure, Surface, TpmsJob};
+use latvox::{Error, Result};
+use std::path::PathBuf;
+
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  # 4×4×4 gyroid cells of 5 mm, network solid at exactly 30 % density
+  latvox tpms --type gyroid --structure net --density 0.3 --cells 4 --cell-size 5 -o gyroid.stl
+
+  # Diamond sheet, 4×4×2 cells of 6 mm, finer voxels, JSON report
+  latvox tpms --type d --structure sheet --density 0.2 --cells 4,4,2 --cell-size 6 \\
+      --resolution 48 -o diamond.stl --report diamond.json
+
+  # A 50×30×10 mm block filled with 10 mm Schwarz-P cells (partial cells at the far sides)
+  latvox tpms --type p --density 0.35 --size 50,30,10 --cell-size 10 -o p-block.stl
+
+Types: p (Schwarz primitive), g|gyroid, d (Schwarz diamond), iwp (Schoen I-WP),
+       s (Fischer–Koch S), frd (Schoen F-RD), n|neovius.
+Structures: net (solid on one side of F = t), sheet (solid where |F| ≤ t).
+The level t is found by latvox so that the written mesh has the requested volume fraction;
+the report gives the target, the fraction CGAL measures on the mesh, and the CGAL checks.";
+
+#[derive(Args)]
+pub struct TpmsArgs {
+    /// Surface: p, gyroid (g), d, iwp, s, frd, neovius (n).
+    #[arg(long = "type", short = 't', value_name = "TYPE", default_value = "gyroid", value_parser = parse_surface)]
+    pub surface: Surface,
+    /// Solid side: net (F ≤ t) or sheet (|F| ≤ t).
+    #[arg(long, value_name = "net|sheet", default_value = "net", value_parser = parse_structure)]
+    pub structure: Structure,
+    /// Target volume fraction of solid, in (0, 1).
+    #[arg(long, short = 'd', default_value_t = 0.3, value_parser = parse_density)]
+    pub density: f64,
+    /// Cells per axis: N or NX,NY,NZ.
+    #[arg(long, value_name = "N[,NY,NZ]", value_parser = parse_counts)]
+    pub cells: Option<[u32; 3]>,
+    /// Cell size in mm: A or AX,AY,AZ.
+    #[arg(long, value_name = "MM[,MM,MM]", value_parser = parse_positive3)]
+    pub cell_size: Option<[f64; 3]>,
+    /// Overall box size in mm (with --cells or --cell-size): S or SX,SY,SZ.
+    #[arg(long, value_name = "MM[,MM,MM]", value_parser = parse_positive3)]
+    pub size: Option<[f64; 3]>,
+    /// Lower corner of the box in mm (lattice phase starts there).
+    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,0", value_parser = parse_finite3)]
+    pub origin: [f64; 3],
+    /// Voxels per cell along the cell's shortest side.
+    #[arg(long, short = 'r', default_value_t = 32, value_parser = clap::value_parser!(u32).range(4..=4096))]
+    pub resolution: u32,
+    /// OpenVDB mesh adaptivity: 0 keeps uniform triangles, up to 1 merges flat regions.
+    #[arg(long, default_value_t = 0.0, value_parser = parse_unit)]
+    pub adaptivity: f64,
+    /// Output mesh (binary STL unless --ascii).
+    #[arg(
+        long,
+        short = 'o',
+        value_name = "FILE.stl",
+        default_value = "lattice.stl"
+    )]
+    pub output: PathBuf,
+    /// Write ASCII STL instead of binary.
+    #[arg(long)]
+    pub ascii: bool,
+    /// Write a JSON report (type, level, densities, mesh counts, CGAL checks, timings).
+    #[arg(long, value_name = "FILE.json")]
+    pub report: Option<PathBuf>,
+    /// Build even when the solid falls apart into islands at this density.
+    #[arg(long)]
+    pub allow_islands: bool,
+    /// Fail instead of raising the resolution when sheet walls would be under 1.25 voxels.
+    #[arg(long)]
+    pub fixed_resolution: bool,
+    /// Skip CGAL's self-intersection test (the slowest check) on very large meshes.
+    #[arg(long)]
+    pub no_self_intersection_check: bool,
+}
+
+pub(crate) fn parse_surface(s: &str) -> std::result::Result<Surface, String> {
+    Surface::parse(s).ok_or_else(|| {
+        format!("unknown TPMS type '{s}' (known: p, gyroid, d, iwp, s, frd, neovius)")
+    })
+}
+
+pub(crate) fn parse_structure(s: &str) -> std::result::Result<Structure, String> {
+    match s.to_ascii_lowercase().as_str() {
+        "net" | "network" | "solid" => Ok(Structure::Net),
+        "sheet" | "shell" => Ok(Structure::Sheet),
+        _ => Err(format!("unknown structure '{s}' (known: net, sheet)")),
+    }
+}
+
+fn domain(a: &TpmsArgs) -> Result<Domain> {
+    match (a.cells, a.cell_size, a.size) {
+        (Some(n), Some(c), None) => Domain::from_cells(n, c, a.origin),
+        (Some(n), None, Some(s)) => Domain::from_size_and_cells(s, n, a.origin),
+        (None, Some(c), Some(s)) => Domain::from_size_and_cell(s, c, a.origin),
+        (Some(n), None, None) => Domain::from_cells(n, [5.0; 3], a.origin),
+        (None, Some(c), None) => Domain::from_cells([4; 3], c, a.origin),
+        (None, None, None) => Domain::from_cells([4; 3], [5.0; 3], a.origin),
+        (None, None, Some(_)) => Err(Error::invalid("--size needs --cells or --cell-size")),
+        (Some(_), Some(_), Some(_)) => Err(Error::invalid(
+            "give two of --cells, --cell-size, --size, not all three",
+        )),
+    }
+}
+
+pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
+    let job = TpmsJob {
+        surface: a.surface,
+        structure: a.structure,
+        density: a.density,
+        domain: domain(a)?,
+        resolution: a.resolution,
+        adaptivity: a.adaptivity,
+        allow_islands: a.allow_islands,
+        auto_resolution: !a.fixed_resolution,
+        self_intersection: !a.no_self_intersection_check,
+    };
+    // Fail on an unwritable destination before the work, not after.
+    latvox::output::check_writable(&a.output)?;
+    if let Some(r) = &a.report {
+        latvox::output::check_writable(r)?;
+    }
+    let progress = latvox::progress::Progress::new(quiet);
+    let (mesh, mut report) = job.run(&progress)?;
+    let t = std::time::Instant::now();
+    {
+        let _p = progress.stage("writing STL");
+        let format = if a.ascii {
+            StlFormat::Ascii
+        } else {
+            StlFormat::Binary
+        };
+        latvox::stl::save(&mesh, format, &a.output)?;
+    }
+    report.timings.write = t.elapsed().as_secs_f64();
+    report.timings.total += report.timings.write;
+    report.output = Some(a.output.display().to_string());
+    if let Some(r) = &a.report {
+        write_json(r, &report)?;
+    }
+    for w in &report.warnings {
+        eprintln!("latvox: warning: {w}");
+    }
+    print_tpms_summary(&report);
+    Ok(
+        if report.checks.is_valid_solid()
+            || !report.checks.self_intersection_checked
+                && report.checks.closed
+                && report.checks.outward
+        {
+            0
+        } else {
+            1
+        },
+    )
+}
+
+fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
+    let c = &r.checks;
+    println!(
+        "{} {} · {}×{}×{} cells of {}×{}×{} mm · {} voxels/cell ({:.4} mm)",
+        r.surface.name(),
+        r.structure.name(),
+        r.cells[0],
+        r.cells[1],
+        r.cells[2],
+        r.cell_size[0],
+        r.cell_size[1],
+        r.cell_size[2],
+        r.resolution,
+        r.voxel_size
+    );
+    println!(
+        "density   target {:.4}  achieved {:.4}  (error {:+.5}, level t = {:.5})",
+        r.target_density, r.achieved_density, r.density_error, r.level
+    );
+    println!(
+        "mesh      {} triangles, {} vertices, area {:.2} mm², volume {:.2} mm³",
+        r.triangles,
+        r.vertices,
+        r.area,
+        r.volume.unwrap_or(f64::NAN)
+    );
+    if let Some(b) = r.bounding_box {
+        println!(
+            "bounds    [{:.3}, {:.3}, {:.3}] – [{:.3}, {:.3}, {:.3}] mm",
+            b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]
+        );
+    }
+    println!(
+        "CGAL      closed {}  outward {}  manifold {}  self-intersections {}",
+        yes(c.closed),
+        yes(c.outward),
+        yes(c.manifold),
+        if !c.self_intersection_checked {
+            "not checked"
+        } else if c.self_intersecting {
+            "FOUND"
+        } else {
+            "none"
+        }
+    );
+    let t = &r.timings;
+    println!(
+        "time      {:.3} s (calibrate {:.3}, sample {:.3}, mesh {:.3}, snap {:.3}, verify {:.3}, write {:.3})",
+        t.total, t.calibrate, t.sample, t.mesh, t.snap, t.verify, t.write
+    );
+    if let Some(o) = &r.output {
+        println!("wrote     {o}");
+    }
+}
