@@ -6,6 +6,7 @@
 //! Capabilities: [`tpms`].
 
 pub mod error;
+pub mod extract;
 pub(crate) mod ffi;
 pub mod field;
 pub mod grid;
