@@ -187,8 +187,8 @@ impl Grid {
         ffi::vdb_extract(&self.inner, &mut out)
             .map_err(|e| Error::backend("meshing the level set (OpenVDB volumeToMesh)", e))?;
         for v in out.voxels.chunks_exact_mut(3) {
-            for a in 0..3 {
-                v[a] += self.frame[a] as i32;
+            for (x, f) in v.iter_mut().zip(self.frame) {
+                *x += f as i32;
             }
         }
         Ok(out)
