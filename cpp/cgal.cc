@@ -75,7 +75,7 @@ bool build_mesh(rust::Slice<const float> positions, rust::Slice<const uint32_t> 
 }  // namespace
 
 CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
-                      bool self_intersection) {
+                      bool self_intersection, bool parallel) {
   CgalReport r{};
   Mesh mesh;
   r.valid_polygon_mesh = build_mesh(positions, indices, mesh);
@@ -97,8 +97,11 @@ CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint
     r.volume = std::numeric_limits<double>::quiet_NaN();
   }
   r.self_intersection_checked = self_intersection;
+  // TBB's parallel search costs about twice the CPU of the sequential one: worth it only when
+  // nothing else needs the other cores.
   r.self_intersecting =
-      self_intersection && PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh);
+      self_intersection && (parallel ? PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh)
+                                     : PMP::does_self_intersect<CGAL::Sequential_tag>(mesh));
   return r;
 }
 

@@ -8,7 +8,7 @@ namespace latvox {
 struct CgalReport;
 
 CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
-                      bool self_intersection);
+                      bool self_intersection, bool parallel);
 
 rust::Vec<uint32_t> cgal_self_intersections(rust::Slice<const float> positions,
                                             rust::Slice<const uint32_t> indices,

@@ -13,6 +13,7 @@ pub mod grid;
 pub mod mesh;
 pub mod output;
 pub mod progress;
+pub mod sink;
 pub mod snap;
 pub mod stl;
 pub mod tpms;

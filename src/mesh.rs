@@ -49,26 +49,18 @@ impl Mesh {
 
     /// Signed enclosed volume (positive for an outward closed mesh), mm³.
     pub fn volume(&self) -> f64 {
-        use rayon::prelude::*;
-        (0..self.triangle_count())
-            .into_par_iter()
-            .map(|t| {
-                let [a, b, c] = self.triangle(t);
-                dot(a, cross(b, c)) / 6.0
-            })
-            .sum()
+        ordered_sum(self.triangle_count(), |t| {
+            let [a, b, c] = self.triangle(t);
+            dot(a, cross(b, c)) / 6.0
+        })
     }
 
     /// Total surface area, mm².
     pub fn area(&self) -> f64 {
-        use rayon::prelude::*;
-        (0..self.triangle_count())
-            .into_par_iter()
-            .map(|t| {
-                let [a, b, c] = self.triangle(t);
-                0.5 * norm(cross(sub(b, a), sub(c, a)))
-            })
-            .sum()
+        ordered_sum(self.triangle_count(), |t| {
+            let [a, b, c] = self.triangle(t);
+            0.5 * norm(cross(sub(b, a), sub(c, a)))
+        })
     }
 
     /// Volume of the part of the enclosed solid that lies inside `b`, mm³.
@@ -79,11 +71,9 @@ impl Mesh {
     /// `∫ clamp(z) dA` on each triangle's projection clipped to the rectangle, signed by the
     /// triangle's facing. Exact for a closed, outward mesh (up to rounding).
     pub fn volume_in_box(&self, b: &Aabb) -> f64 {
-        use rayon::prelude::*;
-        (0..self.triangle_count())
-            .into_par_iter()
-            .map(|t| clipped_column_integral(self.triangle(t), b))
-            .sum()
+        ordered_sum(self.triangle_count(), |t| {
+            clipped_column_integral(self.triangle(t), b)
+        })
     }
 
     /// Axis-aligned bounds of the vertices; `None` for an empty mesh.
@@ -140,6 +130,18 @@ impl Mesh {
             t.swap(1, 2);
         }
     }
+}
+
+/// `Σ f(i)` for `i < n`, in parallel but always added in the same order, so a measure (and the
+/// calibrated level built on it) does not change with the thread count or scheduling.
+pub fn ordered_sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
+    use rayon::prelude::*;
+    const CHUNK: usize = 4096;
+    let partial: Vec<f64> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| (c * CHUNK..((c + 1) * CHUNK).min(n)).map(&f).sum())
+        .collect();
+    partial.iter().sum()
 }
 
 /// Clips a convex polygon to the half-space `s·p[axis] ≤ s·c`.

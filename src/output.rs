@@ -44,17 +44,22 @@ fn parent_dir(path: &Path) -> &Path {
     }
 }
 
+/// A new temporary file in `path`'s folder, with ordinary permissions, to be renamed over
+/// `path` once complete (it is deleted if dropped instead).
+pub fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile> {
+    tempfile::Builder::new()
+        .prefix(".latvox-")
+        .permissions(file_mode())
+        .tempfile_in(parent_dir(path))
+        .map_err(|e| Error::io(path, e))
+}
+
 /// Writes `path` atomically through `body`.
 pub fn write_atomic(
     path: &Path,
     body: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<()> {
-    let dir = parent_dir(path);
-    let tmp = tempfile::Builder::new()
-        .prefix(".latvox-")
-        .permissions(file_mode())
-        .tempfile_in(dir)
-        .map_err(|e| Error::io(path, e))?;
+    let tmp = temp_beside(path)?;
     {
         let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file());
         body(&mut w).map_err(|e| Error::io(path, e))?;

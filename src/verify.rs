@@ -42,7 +42,13 @@ impl Verification {
 
 /// Runs CGAL's checks on `mesh`. `self_intersection` turns on the (costlier) intersection test.
 pub fn verify(mesh: &Mesh, self_intersection: bool) -> Result<Verification> {
-    let r = ffi::cgal_check(&mesh.positions, &mesh.indices, self_intersection)
+    verify_on(mesh, self_intersection, true)
+}
+
+/// [`verify`], with CGAL's self-intersection search on one thread when `parallel` is false (for
+/// checks that run beside other work).
+pub fn verify_on(mesh: &Mesh, self_intersection: bool, parallel: bool) -> Result<Verification> {
+    let r = ffi::cgal_check(&mesh.positions, &mesh.indices, self_intersection, parallel)
         .map_err(|e| Error::backend("CGAL mesh check", e))?;
     Ok(Verification {
         manifold: r.valid_polygon_mesh,

@@ -19,6 +19,7 @@ fn every_type_and_structure_hits_its_target_within_0_002() {
                     allow_islands: true,
                     auto_resolution: true,
                     self_intersection: false,
+                    instancing: true,
                 };
                 let (mesh, r) = job.run(&latvox::progress::Progress::hidden()).unwrap();
                 assert!(

@@ -79,6 +79,10 @@ pub struct TpmsArgs {
     /// Skip CGAL's self-intersection test (the slowest check) on very large meshes.
     #[arg(long)]
     pub no_self_intersection_check: bool,
+    /// Mesh the whole part at once instead of copying its periodic cells from a meshed
+    /// 3×3×3-cell template (slower, same solid; CGAL then checks the whole part).
+    #[arg(long)]
+    pub no_instancing: bool,
 }
 
 pub(crate) fn parse_surface(s: &str) -> std::result::Result<Surface, String> {
@@ -121,6 +125,7 @@ pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
         allow_islands: a.allow_islands,
         auto_resolution: !a.fixed_resolution,
         self_intersection: !a.no_self_intersection_check,
+        instancing: !a.no_instancing,
     };
     // Fail on an unwritable destination before the work, not after.
     latvox::output::check_writable(&a.output)?;
@@ -128,19 +133,15 @@ pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
         latvox::output::check_writable(r)?;
     }
     let progress = latvox::progress::Progress::new(quiet);
-    let (mesh, mut report) = job.run(&progress)?;
-    let t = std::time::Instant::now();
-    {
-        let _p = progress.stage("writing STL");
-        let format = if a.ascii {
-            StlFormat::Ascii
-        } else {
-            StlFormat::Binary
-        };
-        latvox::stl::save(&mesh, format, &a.output)?;
-    }
-    report.timings.write = t.elapsed().as_secs_f64();
-    report.timings.total += report.timings.write;
+    let format = if a.ascii {
+        StlFormat::Ascii
+    } else {
+        StlFormat::Binary
+    };
+    // The part streams into a temporary file that becomes the output only once the job is done.
+    let mut sink = latvox::sink::StlSink::create(&a.output, format)?;
+    let mut report = job.run_into(&progress, &mut sink)?;
+    sink.commit()?;
     report.output = Some(a.output.display().to_string());
     if let Some(r) = &a.report {
         write_json(r, &report)?;

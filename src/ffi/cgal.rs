@@ -26,6 +26,7 @@ pub(crate) mod ffi {
             positions: &[f32],
             indices: &[u32],
             self_intersection: bool,
+            parallel: bool,
         ) -> Result<CgalReport>;
 
         /// Up to `limit` intersecting face pairs, flattened (face indices in input order).

@@ -1,12 +1,14 @@
 //! One TPMS job, start to finish: check the request, calibrate, mesh, verify, and report.
 
 use super::calibrate::{self, Calibration, Connectivity, FeasibleRange};
+use super::instance::{self, Template};
 use super::{Domain, Lattice, MeshingStats, Structure, Surface};
 use crate::error::{Error, Result};
 use crate::field::Aabb;
 use crate::mesh::Mesh;
 use crate::progress::Progress;
-use crate::verify::{verify, Verification};
+use crate::sink::{Measures, MeshCollector, MeshSink, Triangle};
+use crate::verify::{verify, verify_on, Verification};
 use std::time::Instant;
 
 /// Sheet walls thinner than this many voxels are not represented faithfully by a narrow band
@@ -31,6 +33,9 @@ pub struct TpmsJob {
     pub auto_resolution: bool,
     /// Run CGAL's self-intersection test (the costliest check).
     pub self_intersection: bool,
+    /// Copy a periodic part's cells from a meshed template where possible ([`instance`]);
+    /// otherwise the whole part is meshed at once.
+    pub instancing: bool,
 }
 
 /// Timings per stage, seconds.
@@ -45,6 +50,19 @@ pub struct Timings {
     pub total: f64,
 }
 
+/// How the part was meshed when it was copied from a template (see [`instance`]).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Instancing {
+    /// Cells of the part per axis that the template stands for (1 along axes not copied).
+    pub part_cells: [i64; 3],
+    /// Cells of the template per axis.
+    pub template_cells: [i64; 3],
+    pub template_triangles: u64,
+    /// CGAL's checks ran on the template, which holds every kind of cell the part has; the
+    /// part is written as exact copies of its cells.
+    pub verified: &'static str,
+}
+
 /// The JSON report of a TPMS job.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct TpmsReport {
@@ -53,7 +71,8 @@ pub struct TpmsReport {
     pub structure: Structure,
     pub level: f64,
     pub target_density: f64,
-    /// Volume fraction of the written mesh: CGAL's enclosed volume over the box volume.
+    /// Volume fraction of the written mesh: its enclosed volume (divergence theorem over the
+    /// triangles exactly as written) over the box volume.
     pub achieved_density: f64,
     pub density_error: f64,
     pub calibration: Calibration,
@@ -73,7 +92,9 @@ pub struct TpmsReport {
     pub area: f64,
     pub volume: Option<f64>,
     pub bounding_box: Option<Aabb>,
+    /// CGAL's checks: on the written mesh, or on the template when `instancing` is set.
     pub checks: Verification,
+    pub instancing: Option<Instancing>,
     pub meshing: MeshingStats,
     pub timings: Timings,
     pub warnings: Vec<String>,
@@ -103,8 +124,15 @@ impl TpmsJob {
         Ok(())
     }
 
-    /// Runs the job up to a verified mesh; the caller writes it and fills in `timings.write`.
+    /// Runs the job and returns the mesh with its report.
     pub fn run(&self, progress: &Progress) -> Result<(Mesh, TpmsReport)> {
+        let mut collector = MeshCollector::default();
+        let report = self.run_into(progress, &mut collector)?;
+        Ok((collector.mesh, report))
+    }
+
+    /// Runs the job, streaming the part's triangles into `sink`.
+    pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<TpmsReport> {
         let start = Instant::now();
         self.validate()?;
         let (s, st) = (self.surface, self.structure);
@@ -181,25 +209,89 @@ impl TpmsJob {
             bounds,
             phase: bounds.min,
         };
-        let (mesh, meshing) = {
-            let _p = progress.stage("sampling and meshing");
-            lattice.mesh(voxel, self.adaptivity)?
+        let plan = if self.instancing && self.adaptivity == 0.0 {
+            instance::plan(self.domain.size, cell, voxel)
+        } else {
+            None
         };
-        let t = Instant::now();
-        let checks = {
-            let _p = progress.stage("verifying with CGAL");
-            verify(&mesh, self.self_intersection)?
-        };
-        let verify_seconds = t.elapsed().as_secs_f64();
-        let volume = checks.volume;
-        let achieved = volume.unwrap_or(f64::NAN) / bounds.volume();
+        let (checks, meshing, measures, vertices, instancing, verify_seconds, write_seconds) =
+            match plan {
+                Some(plan) => {
+                    let (template, meshing) = {
+                        let _p = progress.stage("sampling and meshing the template");
+                        Template::build(&lattice, voxel, plan)?
+                    };
+                    // CGAL checks the template while the part is written: the two share the cores.
+                    let template_mesh = template.mesh.to_mesh();
+                    let (checks, verify_seconds, measures, write_seconds) = {
+                        let _p = progress.stage("writing the part and verifying its template");
+                        std::thread::scope(|scope| {
+                            let checker = scope.spawn(|| {
+                                let t = Instant::now();
+                                let r = verify_on(&template_mesh, self.self_intersection, false);
+                                (r, t.elapsed().as_secs_f64())
+                            });
+                            let t = Instant::now();
+                            let measures = template.expand(sink);
+                            let write_seconds = t.elapsed().as_secs_f64();
+                            let (checks, verify_seconds) =
+                                checker.join().expect("the CGAL check does not panic");
+                            (checks, verify_seconds, measures, write_seconds)
+                        })
+                    };
+                    let (checks, measures) = (checks?, measures?);
+                    let instancing = Instancing {
+                        part_cells: plan.map(|a| a.n),
+                        template_cells: plan.map(|a| a.m),
+                        template_triangles: template.mesh.triangle_count() as u64,
+                        verified: "template",
+                    };
+                    (
+                        checks,
+                        meshing,
+                        measures,
+                        template.vertex_count(),
+                        Some(instancing),
+                        verify_seconds,
+                        write_seconds,
+                    )
+                }
+                None => {
+                    let (mesh, meshing) = {
+                        let _p = progress.stage("sampling and meshing");
+                        lattice.mesh(voxel, self.adaptivity)?
+                    };
+                    let t = Instant::now();
+                    let checks = {
+                        let _p = progress.stage("verifying with CGAL");
+                        verify(&mesh, self.self_intersection)?
+                    };
+                    let verify_seconds = t.elapsed().as_secs_f64();
+                    let t = Instant::now();
+                    let measures = {
+                        let _p = progress.stage("writing the part");
+                        write_mesh(&mesh, sink)?
+                    };
+                    (
+                        checks,
+                        meshing,
+                        measures,
+                        mesh.vertex_count() as u64,
+                        None,
+                        verify_seconds,
+                        t.elapsed().as_secs_f64(),
+                    )
+                }
+            };
+        let volume = measures.volume;
+        let achieved = volume / bounds.volume();
         if !checks.is_valid_solid() && (checks.self_intersection_checked || !checks.closed) {
             warnings.push(
                 "CGAL did not find the mesh a valid closed, outward, self-intersection-free solid"
                     .into(),
             );
         }
-        let report = TpmsReport {
+        Ok(TpmsReport {
             surface: s,
             structure: st,
             level: cal.level,
@@ -216,25 +308,50 @@ impl TpmsJob {
             cell_size: cell,
             cells: self.domain.counts(),
             bounds,
-            triangles: mesh.triangle_count() as u64,
-            vertices: mesh.vertex_count() as u64,
-            area: checks.area,
-            volume,
-            bounding_box: mesh.bounds(),
+            triangles: measures.triangles,
+            vertices,
+            area: measures.area,
+            volume: Some(volume),
+            bounding_box: (measures.triangles > 0).then_some(measures.bounds),
             checks,
+            instancing,
             timings: Timings {
                 calibrate: cal.seconds,
                 sample: meshing.sample_seconds,
                 mesh: meshing.mesh_seconds,
                 snap: meshing.snap_seconds,
                 verify: verify_seconds,
-                write: 0.0,
+                write: write_seconds,
                 total: start.elapsed().as_secs_f64(),
             },
             meshing,
             warnings,
             output: None,
-        };
-        Ok((mesh, report))
+        })
     }
+}
+
+/// Streams an in-memory mesh into `sink` in batches, measuring it on the way.
+fn write_mesh(mesh: &Mesh, sink: &mut dyn MeshSink) -> Result<Measures> {
+    use rayon::prelude::*;
+    sink.begin(Some(mesh.triangle_count() as u64))?;
+    let mut measures = Measures::default();
+    const BATCH: usize = 1 << 16;
+    for start in (0..mesh.triangle_count()).step_by(BATCH) {
+        let end = (start + BATCH).min(mesh.triangle_count());
+        let tris: Vec<Triangle> = (start..end)
+            .into_par_iter()
+            .map(|t| {
+                let i = &mesh.indices[3 * t..3 * t + 3];
+                [i[0], i[1], i[2]].map(|v| {
+                    let p = &mesh.positions[3 * v as usize..3 * v as usize + 3];
+                    [p[0], p[1], p[2]]
+                })
+            })
+            .collect();
+        measures = measures.merged(&Measures::of(&tris));
+        sink.triangles(&tris)?;
+    }
+    sink.finish()?;
+    Ok(measures)
 }

@@ -9,6 +9,7 @@
 //! cell, so every whole cell of the part is meshed exactly like the calibration's unit cell.
 
 pub mod calibrate;
+pub mod instance;
 pub mod job;
 pub mod surface;
 
@@ -87,7 +88,9 @@ impl Lattice {
         adaptivity: f64,
     ) -> Result<(KeyedMesh, MeshingStats)> {
         use std::time::Instant;
-        let tpms = self.field(spec.half_width * spec.voxel);
+        let tpms = self
+            .field(spec.half_width * spec.voxel)
+            .with_periodic_samples(spec.voxel);
         let solid = Intersection {
             a: tpms,
             b: self.bounds,

@@ -243,6 +243,11 @@ pub struct TpmsField {
     pub origin: Vec3,
     /// Values are clamped to ±`clamp` (the narrow band's background value).
     pub clamp: f64,
+    /// Samples per cell along each axis, when a cell holds a whole number of samples: block
+    /// sampling then takes each sample's phase from its index modulo this count, so samples one
+    /// cell apart are bit-identical and a periodic lattice meshes identically in every cell.
+    /// (The count per axis and the voxel size it was made for.)
+    pub samples_per_cell: Option<([u32; 3], f64)>,
     lipschitz: f64,
 }
 
@@ -265,8 +270,17 @@ impl TpmsField {
             cell,
             origin,
             clamp,
+            samples_per_cell: None,
             lipschitz,
         }
+    }
+
+    /// Turns on index-periodic block sampling when a cell spans a whole number of voxels `h`.
+    pub fn with_periodic_samples(mut self, h: f64) -> Self {
+        let p = self.cell.map(|c| (c / h).round());
+        let whole = (0..3).all(|a| p[a] >= 1.0 && (self.cell[a] / h - p[a]).abs() < 1e-9 * p[a]);
+        self.samples_per_cell = whole.then(|| (p.map(|x| x as u32), h));
+        self
     }
 
     /// The implicit function whose zero set is the surface: `F − t` or `|F| − t`.
@@ -334,9 +348,19 @@ impl Field for TpmsField {
     fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
         let mut tabs = [[AxisTable::default(); 8]; 3];
         for (a, tab) in tabs.iter_mut().enumerate() {
+            // Index of the block's first sample from the phase origin, if samples sit at
+            // phase + (j + ½)·h and a cell holds a whole number of them.
+            let periodic = self.samples_per_cell.and_then(|(p, hp)| {
+                let j = (origin[a] - self.origin[a]) / h - 0.5;
+                let r = j.round();
+                (hp == h && (j - r).abs() < 1e-6).then_some((r as i64, p[a] as i64))
+            });
             for (i, t) in tab.iter_mut().enumerate() {
-                *t =
-                    AxisTable::at(TAU * (origin[a] + h * i as f64 - self.origin[a]) / self.cell[a]);
+                let u = match periodic {
+                    Some((j0, p)) => ((j0 + i as i64).rem_euclid(p) as f64 + 0.5) / p as f64,
+                    None => (origin[a] + h * i as f64 - self.origin[a]) / self.cell[a],
+                };
+                *t = AxisTable::at(TAU * u);
             }
         }
         let terms = self.surface.terms();
@@ -438,6 +462,33 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn periodic_sampling_repeats_bit_for_bit_and_agrees_with_world_sampling() {
+        let h = 5.0 / 32.0;
+        let phase = [1.0, -2.0, 0.5];
+        let f = TpmsField::new(Surface::Gyroid, Structure::Net, 0.2, [5.0; 3], phase, 1.0);
+        let periodic = f.with_periodic_samples(h);
+        assert_eq!(periodic.samples_per_cell, Some(([32; 3], h)));
+        let at = |field: &TpmsField, block: [f64; 3]| {
+            let mut out = [0.0f32; 512];
+            let o = [0, 1, 2].map(|a| phase[a] + (block[a] * 8.0 + 0.5) * h);
+            field.sample_block(o, h, &mut out);
+            out
+        };
+        for b in [[0.0, 0.0, 0.0], [1.0, 3.0, -2.0]] {
+            let here = at(&periodic, b);
+            // Three cells further along x and one back along z: 12 and −4 blocks of 8 samples.
+            let there = at(&periodic, [b[0] + 12.0, b[1], b[2] - 4.0]);
+            assert_eq!(here, there);
+            let world = at(&f, b);
+            for (p, w) in here.iter().zip(world.iter()) {
+                assert!((p - w).abs() < 1e-5, "{p} vs {w}");
+            }
+        }
+        // A cell that is not a whole number of voxels gets no periodic sampling.
+        assert_eq!(f.with_periodic_samples(5.0 / 31.5).samples_per_cell, None);
     }
 
     #[test]

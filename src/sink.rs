@@ -1,0 +1,271 @@
+//! Sinks: where a mesh streams to, a batch of triangles at a time, so a part never has to be
+//! held whole in memory to be written.
+//!
+//! [`StlSink`] writes binary or ASCII STL into a temporary file beside the destination and
+//! renames it over the destination only when [`StlSink::commit`] is called: a run that fails, or
+//! is killed, leaves no partial file. [`MeshCollector`] gathers the triangles into an indexed
+//! [`Mesh`] instead (welding bit-identical vertices), for callers that want the mesh itself.
+//! [`Measures`] accumulates what every sink's caller reports: triangle count, enclosed volume,
+//! area and bounds of the triangles exactly as they are written.
+
+use crate::error::{Error, Result};
+use crate::field::Aabb;
+use crate::mesh::Mesh;
+use crate::stl::StlFormat;
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// A triangle as written: three corners in single precision, wound outward.
+pub type Triangle = [[f32; 3]; 3];
+
+/// Receives a mesh as batches of triangles, in order.
+pub trait MeshSink {
+    /// Called once before any triangle, with the total count when it is known in advance.
+    fn begin(&mut self, triangles: Option<u64>) -> Result<()>;
+    fn triangles(&mut self, batch: &[Triangle]) -> Result<()>;
+    fn finish(&mut self) -> Result<()>;
+}
+
+/// Running measures of the triangles written so far.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measures {
+    pub triangles: u64,
+    /// Signed enclosed volume by the divergence theorem, mm³ (exact only for a closed mesh).
+    pub volume: f64,
+    pub area: f64,
+    pub bounds: Aabb,
+}
+
+impl Default for Measures {
+    fn default() -> Self {
+        Measures {
+            triangles: 0,
+            volume: 0.0,
+            area: 0.0,
+            bounds: Aabb {
+                min: [f64::INFINITY; 3],
+                max: [f64::NEG_INFINITY; 3],
+            },
+        }
+    }
+}
+
+impl Measures {
+    /// The measures of `batch`, computed in parallel and summed in a fixed order (the same
+    /// result whatever the thread count).
+    pub fn of(batch: &[Triangle]) -> Measures {
+        let parts: Vec<Measures> = batch.par_chunks(4096).map(Measures::of_serial).collect();
+        parts.iter().fold(Measures::default(), |a, b| a.merged(b))
+    }
+
+    /// The measures of `batch`, on this thread.
+    pub fn of_serial(batch: &[Triangle]) -> Measures {
+        let mut m = Measures::default();
+        for t in batch {
+            m.add(t);
+        }
+        m
+    }
+
+    fn add(&mut self, t: &Triangle) {
+        use crate::mesh::{cross, dot, norm, sub};
+        let p = t.map(|v| v.map(|x| x as f64));
+        self.triangles += 1;
+        self.volume += dot(p[0], cross(p[1], p[2])) / 6.0;
+        self.area += 0.5 * norm(cross(sub(p[1], p[0]), sub(p[2], p[0])));
+        for v in p {
+            for (a, x) in v.into_iter().enumerate() {
+                self.bounds.min[a] = self.bounds.min[a].min(x);
+                self.bounds.max[a] = self.bounds.max[a].max(x);
+            }
+        }
+    }
+
+    pub fn merged(&self, o: &Measures) -> Measures {
+        Measures {
+            triangles: self.triangles + o.triangles,
+            volume: self.volume + o.volume,
+            area: self.area + o.area,
+            bounds: Aabb {
+                min: [0, 1, 2].map(|a| self.bounds.min[a].min(o.bounds.min[a])),
+                max: [0, 1, 2].map(|a| self.bounds.max[a].max(o.bounds.max[a])),
+            },
+        }
+    }
+}
+
+/// Streams STL into a temporary file beside `path`; [`StlSink::commit`] renames it into place.
+pub struct StlSink {
+    path: PathBuf,
+    format: StlFormat,
+    tmp: Option<tempfile::NamedTempFile>,
+    out: Option<std::io::BufWriter<std::fs::File>>,
+    written: u64,
+    announced: Option<u64>,
+    buf: Vec<u8>,
+}
+
+impl StlSink {
+    /// Opens the temporary file (the destination folder must be writable).
+    pub fn create(path: &Path, format: StlFormat) -> Result<StlSink> {
+        let tmp = crate::output::temp_beside(path)?;
+        let file = tmp.reopen().map_err(|e| Error::io(path, e))?;
+        Ok(StlSink {
+            path: path.to_path_buf(),
+            format,
+            tmp: Some(tmp),
+            out: Some(std::io::BufWriter::with_capacity(1 << 22, file)),
+            written: 0,
+            announced: None,
+            buf: Vec::new(),
+        })
+    }
+
+    fn io(&self, e: std::io::Error) -> Error {
+        Error::io(&self.path, e)
+    }
+
+    fn writer(&mut self) -> &mut std::io::BufWriter<std::fs::File> {
+        self.out.as_mut().expect("STL sink used after commit")
+    }
+
+    /// Moves the finished file into place.
+    pub fn commit(mut self) -> Result<()> {
+        if let Some(mut w) = self.out.take() {
+            w.flush().map_err(|e| Error::io(&self.path, e))?;
+        }
+        let tmp = self.tmp.take().expect("STL sink committed twice");
+        tmp.persist(&self.path)
+            .map_err(|e| Error::io(&self.path, e.error))?;
+        Ok(())
+    }
+}
+
+fn unit_normal(t: &Triangle) -> [f32; 3] {
+    use crate::mesh::{cross, norm, sub};
+    let p = t.map(|v| v.map(|x| x as f64));
+    let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+    let l = norm(n);
+    if l > 0.0 {
+        n.map(|x| (x / l) as f32)
+    } else {
+        [0.0; 3]
+    }
+}
+
+impl MeshSink for StlSink {
+    fn begin(&mut self, triangles: Option<u64>) -> Result<()> {
+        self.announced = triangles;
+        let r = match self.format {
+            StlFormat::Binary => {
+                let mut header = [b' '; 80];
+                let tag = b"binary STL written by latvox";
+                header[..tag.len()].copy_from_slice(tag);
+                let count = u32::try_from(triangles.unwrap_or(0)).map_err(|_| {
+                    Error::invalid("more than 2^32 triangles cannot be written as binary STL")
+                })?;
+                let w = self.writer();
+                w.write_all(&header)
+                    .and_then(|_| w.write_all(&count.to_le_bytes()))
+            }
+            StlFormat::Ascii => writeln!(self.writer(), "solid latvox"),
+        };
+        r.map_err(|e| self.io(e))
+    }
+
+    fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
+        self.written += batch.len() as u64;
+        let mut buf = std::mem::take(&mut self.buf);
+        buf.clear();
+        match self.format {
+            StlFormat::Binary => {
+                buf.resize(batch.len() * 50, 0);
+                buf.par_chunks_mut(50)
+                    .zip(batch.par_iter())
+                    .for_each(|(rec, t)| {
+                        let n = unit_normal(t);
+                        let vals = n.iter().chain(t.iter().flatten());
+                        for (k, v) in vals.enumerate() {
+                            rec[4 * k..4 * k + 4].copy_from_slice(&v.to_le_bytes());
+                        }
+                        rec[48] = 0;
+                        rec[49] = 0;
+                    });
+            }
+            StlFormat::Ascii => {
+                for t in batch {
+                    let n = unit_normal(t);
+                    let _ = writeln!(buf, "  facet normal {:e} {:e} {:e}", n[0], n[1], n[2]);
+                    let _ = writeln!(buf, "    outer loop");
+                    for p in t {
+                        let _ = writeln!(buf, "      vertex {:e} {:e} {:e}", p[0], p[1], p[2]);
+                    }
+                    let _ = writeln!(buf, "    endloop");
+                    let _ = writeln!(buf, "  endfacet");
+                }
+            }
+        }
+        let r = self.writer().write_all(&buf);
+        self.buf = buf;
+        r.map_err(|e| self.io(e))
+    }
+
+    fn finish(&mut self) -> Result<()> {
+        if self.format == StlFormat::Ascii {
+            let r = writeln!(self.writer(), "endsolid latvox");
+            r.map_err(|e| self.io(e))?;
+        } else if self.announced != Some(self.written) {
+            // The count was not known up front: patch it into the header.
+            use std::io::{Seek, SeekFrom};
+            let count = u32::try_from(self.written).map_err(|_| {
+                Error::invalid("more than 2^32 triangles cannot be written as binary STL")
+            })?;
+            let w = self.writer();
+            let r = w
+                .flush()
+                .and_then(|_| w.get_mut().seek(SeekFrom::Start(80)))
+                .and_then(|_| w.get_mut().write_all(&count.to_le_bytes()))
+                .and_then(|_| w.get_mut().seek(SeekFrom::End(0)).map(drop));
+            r.map_err(|e| self.io(e))?;
+        }
+        let r = self.writer().flush();
+        r.map_err(|e| self.io(e))
+    }
+}
+
+/// Gathers streamed triangles into an indexed mesh, welding bit-identical corners.
+#[derive(Default)]
+pub struct MeshCollector {
+    pub mesh: Mesh,
+    index: HashMap<[u32; 3], u32>,
+}
+
+impl MeshSink for MeshCollector {
+    fn begin(&mut self, triangles: Option<u64>) -> Result<()> {
+        if let Some(n) = triangles {
+            self.mesh.indices.reserve(3 * n as usize);
+        }
+        Ok(())
+    }
+
+    fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
+        for t in batch {
+            for p in t {
+                let key = p.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
+                let next = self.index.len() as u32;
+                let id = *self.index.entry(key).or_insert(next);
+                if id == next {
+                    self.mesh.positions.extend_from_slice(p);
+                }
+                self.mesh.indices.push(id);
+            }
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self) -> Result<()> {
+        Ok(())
+    }
+}
