@@ -3,7 +3,8 @@
 //! level sets and meshes them; CGAL verifies the result.
 //!
 //! Stages, one module each: [`field`] → [`grid`] → [`mesh`] → [`verify`] → [`stl`] (output).
-//! Capabilities: [`tpms`].
+//! Capabilities: [`tpms`], [`topopt`] (SIMP optimiser), [`topo`] (density fields to STL and CAD),
+//! [`cad`] (B-spline curves, IGES, DXF).
 
 pub mod error;
 pub(crate) mod ffi;
@@ -14,6 +15,8 @@ pub mod output;
 pub mod progress;
 pub mod snap;
 pub mod stl;
+pub mod topo;
+pub mod topopt;
 pub mod tpms;
 pub mod verify;
 
