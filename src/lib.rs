@@ -6,6 +6,7 @@
 //! Capabilities: [`tpms`], [`topopt`] (SIMP optimiser), [`topo`] (density fields to STL and CAD),
 //! [`cad`] (B-spline curves, IGES, DXF).
 
+pub mod cad;
 pub mod error;
 pub(crate) mod ffi;
 pub mod field;

@@ -25,7 +25,7 @@ Examples:
 
 Built-in problems: mbb (half MBB beam), cantilever (left edge clamped, load down at the lower
 right), lbeam (L-bracket, top clamped, load at the arm's end), heat (conduction plate, uniform
-heat, corners held at T = 0), cantilever3d (top3d's line-loaded cantilever).
+heat, sink at the middle of the left edge), cantilever3d (top3d's line-loaded cantilever).
 
 A problem file (TOML): node ranges are inclusive grid coordinates from the lower-left corner,
 in elements; passive element ranges are half-open.

@@ -164,10 +164,9 @@ mod tests {
         let a = parse(&buf).unwrap();
         assert_eq!(a.shape, vec![2, 3]);
         assert_eq!(a.data, vec![0., 1., 2., 3., 4., 5.]);
-        let text = buf.clone();
-        let s = String::from_utf8_lossy(&text[..80]).replace("False", "True ");
-        let mut f = s.into_bytes();
-        f.extend_from_slice(&text[80..]);
+        let at = buf.windows(5).position(|w| w == b"False").unwrap();
+        let mut f = buf.clone();
+        f[at..at + 5].copy_from_slice(b"True ");
         let b = parse(&f).unwrap();
         // Fortran data 0..6 of shape (2, 3) is [[0, 2, 4], [1, 3, 5]].
         assert_eq!(b.data, vec![0., 2., 4., 1., 3., 5.]);

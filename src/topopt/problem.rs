@@ -222,16 +222,15 @@ pub fn builtin(name: &str, dims: Option<[usize; 3]>) -> Result<Problem> {
             }
             p.loads = vec![(2 * p.node(nelx, ay / 2, 0) + 1, -1.0)];
         }
-        // Heat conduction plate: uniform heat generation, held at T = 0 at the four corners.
+        // Heat conduction plate (the volume-to-point problem): uniform heat generation, all
+        // edges insulated except a sink held at T = 0 at the middle of the left edge.
         "heat" => {
             p.physics = Physics::Heat;
             p.emin = 1e-3;
-            p.fixed = vec![
-                p.node(0, 0, 0),
-                p.node(nelx, 0, 0),
-                p.node(0, nely, 0),
-                p.node(nelx, nely, 0),
-            ];
+            let half = (nely / 20).max(1);
+            p.fixed = (nely / 2 - half.min(nely / 2)..=(nely / 2 + half).min(nely))
+                .map(|iy| p.node(0, iy, 0))
+                .collect();
             p.loads = (0..p.nodes()).map(|n| (n, 0.01)).collect();
         }
         // top3d's default: left face clamped, a line load down along the lower right edge.
