@@ -31,9 +31,10 @@ else
   echo "install-deps: all packages present" >&2
 fi
 
-# Python packages for the tests: NumPy/SciPy (reference optimisers) and gmsh (OpenCASCADE).
-PY_PKGS=(numpy scipy gmsh)
-if python3 -c "import numpy, scipy, gmsh" 2>/dev/null; then
+# Python packages for the tests: NumPy/SciPy (reference optimisers, independent checks of the
+# cleaned fields), gmsh (OpenCASCADE reads the IGES back) and ezdxf (reads the DXF back).
+PY_PKGS=(numpy scipy gmsh ezdxf)
+if python3 -c "import numpy, scipy, gmsh, ezdxf" 2>/dev/null; then
   echo "install-deps: Python packages present" >&2
 else
   echo "install-deps: installing Python packages ${PY_PKGS[*]}" >&2
@@ -43,5 +44,5 @@ else
   else
     pip_install --user 2>/dev/null || pip_install --user --break-system-packages
   fi
-  python3 -c "import numpy, scipy, gmsh"
+  python3 -c "import numpy, scipy, gmsh, ezdxf"
 fi

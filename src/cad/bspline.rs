@@ -8,6 +8,7 @@
 //! [`Periodic::unwrapped`].
 
 use faer::linalg::solvers::Solve;
+use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 
 pub type P2 = [f64; 2];
@@ -19,9 +20,25 @@ pub struct Periodic {
     pub knots: Vec<f64>,
     pub period: f64,
     pub points: Vec<P2>,
+    /// `t_k` for `k = −4 … m + 4`, at `ext[k + 4]` (evaluation reads knots a lot).
+    ext: Vec<f64>,
 }
 
 impl Periodic {
+    /// A curve with `knots` in `[0, period)` (strictly increasing) and `points`.
+    pub fn new(knots: Vec<f64>, period: f64, points: Vec<P2>) -> Periodic {
+        let m = knots.len() as isize;
+        let ext = (-4..m + 5)
+            .map(|k| knots[k.rem_euclid(m) as usize] + k.div_euclid(m) as f64 * period)
+            .collect();
+        Periodic {
+            knots,
+            period,
+            points,
+            ext,
+        }
+    }
+
     pub fn len(&self) -> usize {
         self.points.len()
     }
@@ -33,6 +50,9 @@ impl Periodic {
     /// Knot `t_k` for any integer `k`.
     pub fn t(&self, k: isize) -> f64 {
         let m = self.knots.len() as isize;
+        if (-4..m + 5).contains(&k) {
+            return self.ext[(k + 4) as usize];
+        }
         let q = k.div_euclid(m);
         self.knots[k.rem_euclid(m) as usize] + q as f64 * self.period
     }
@@ -43,12 +63,13 @@ impl Periodic {
         let uu = u.rem_euclid(self.period);
         let q = ((u - uu) / self.period).round() as isize;
         // Last knot ≤ uu.
-        let j = match self.knots.binary_search_by(|k| k.total_cmp(&uu)) {
+        let j0 = match self.knots.binary_search_by(|k| k.total_cmp(&uu)) {
             Ok(i) => i,
             Err(i) => i.max(1) - 1,
-        } as isize
-            + q * m as isize;
-        (j, basis_at(|k| self.t(k), j, u))
+        } as isize;
+        // Evaluate in the base period (knots from the cached table), report the true span.
+        let n = basis_at(|k| self.ext[(k + 4) as usize], j0, uu);
+        (j0 + q * m as isize, n)
     }
 
     pub fn eval(&self, u: f64) -> P2 {
@@ -73,50 +94,51 @@ impl Periodic {
         (knots, pts, [self.t(3), self.t(m as isize + 3)])
     }
 
-    /// The parameter nearest to `p`, searched around `guess` within `window`.
+    /// The parameter nearest to `p`, searched around `guess` within `window`: a coarse scan,
+    /// then Newton's method on `(C(u) − p)·C′(u) = 0`. Returns `(u, distance)`.
     pub fn project(&self, p: P2, guess: f64, window: f64) -> (f64, f64) {
         let d2 = |u: f64| {
             let c = self.eval(u);
             (c[0] - p[0]).powi(2) + (c[1] - p[1]).powi(2)
         };
-        let steps = 12;
-        let (mut best_u, mut best) = (guess, d2(guess));
+        let steps = 6;
+        let (mut u, mut best) = (guess, d2(guess));
         for s in 0..=steps {
-            let u = guess - window + 2.0 * window * s as f64 / steps as f64;
-            let v = d2(u);
-            if v < best {
-                best = v;
-                best_u = u;
+            let v = guess - window + 2.0 * window * s as f64 / steps as f64;
+            let dv = d2(v);
+            if dv < best {
+                best = dv;
+                u = v;
             }
         }
-        // Golden-section refinement around the best sample.
-        let h = 2.0 * window / steps as f64;
-        let (mut a, mut b) = (best_u - h, best_u + h);
-        let g = 0.5 * (5f64.sqrt() - 1.0);
-        let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-        let (mut fc, mut fd) = (d2(c), d2(d));
-        for _ in 0..40 {
-            if fc < fd {
-                b = d;
-                d = c;
-                fd = fc;
-                c = b - g * (b - a);
-                fc = d2(c);
-            } else {
-                a = c;
-                c = d;
-                fc = fd;
-                d = a + g * (b - a);
-                fd = d2(d);
+        let h = 1e-4 * window.max(1e-9);
+        let (lo, hi) = (guess - window, guess + window);
+        for _ in 0..6 {
+            let (a, c, b) = (self.eval(u - h), self.eval(u), self.eval(u + h));
+            let d1 = [(b[0] - a[0]) / (2.0 * h), (b[1] - a[1]) / (2.0 * h)];
+            let dd = [
+                (b[0] - 2.0 * c[0] + a[0]) / (h * h),
+                (b[1] - 2.0 * c[1] + a[1]) / (h * h),
+            ];
+            let r = [c[0] - p[0], c[1] - p[1]];
+            let f = r[0] * d1[0] + r[1] * d1[1];
+            let fp = d1[0] * d1[0] + d1[1] * d1[1] + r[0] * dd[0] + r[1] * dd[1];
+            if fp <= 0.0 {
+                break;
+            }
+            let next = (u - f / fp).clamp(lo, hi);
+            let dn = d2(next);
+            if dn > best {
+                break;
+            }
+            let done = (next - u).abs() < 1e-10 * window.max(1.0);
+            u = next;
+            best = dn;
+            if done {
+                break;
             }
         }
-        let u = 0.5 * (a + b);
-        let v = d2(u);
-        if v < best {
-            (u, v.sqrt())
-        } else {
-            (best_u, best.sqrt())
-        }
+        (u, best.sqrt())
     }
 }
 
@@ -144,12 +166,15 @@ fn basis_at(t: impl Fn(isize) -> f64, j: isize, u: f64) -> [f64; 4] {
 /// parameters `params`. A tiny second-difference penalty keeps spans without data determined.
 pub fn fit(pts: &[P2], params: &[f64], knots: Vec<f64>, period: f64) -> Periodic {
     let m = knots.len();
-    let mut curve = Periodic {
-        knots,
-        period,
-        points: vec![[0.0; 2]; m],
+    let mut curve = Periodic::new(knots, period, vec![[0.0; 2]; m]);
+    // Normal equations: cyclic, seven diagonals. Assembled sparse, solved by sparse Cholesky.
+    let mut entries: std::collections::HashMap<(usize, usize), f64> =
+        std::collections::HashMap::with_capacity(8 * m);
+    let mut add = |r: usize, c: usize, v: f64| {
+        if r >= c {
+            *entries.entry((r, c)).or_insert(0.0) += v;
+        }
     };
-    let mut a = Mat::<f64>::zeros(m, m);
     let mut rhs = Mat::<f64>::zeros(m, 2);
     for (p, &u) in pts.iter().zip(params) {
         let (j, n) = curve.basis(u);
@@ -157,7 +182,7 @@ pub fn fit(pts: &[P2], params: &[f64], knots: Vec<f64>, period: f64) -> Periodic
             [0, 1, 2, 3].map(|r| (j - 3 + r as isize).rem_euclid(m as isize) as usize);
         for r in 0..4 {
             for s in 0..4 {
-                a[(idx[r], idx[s])] += n[r] * n[s];
+                add(idx[r], idx[s], n[r] * n[s]);
             }
             rhs[(idx[r], 0)] += n[r] * p[0];
             rhs[(idx[r], 1)] += n[r] * p[1];
@@ -169,14 +194,19 @@ pub fn fit(pts: &[P2], params: &[f64], knots: Vec<f64>, period: f64) -> Periodic
         let c = [1.0, -2.0, 1.0];
         for r in 0..3 {
             for s in 0..3 {
-                a[(w[r], w[s])] += lambda * c[r] * c[s];
+                add(w[r], w[s], lambda * c[r] * c[s]);
             }
         }
     }
-    let sol = match a.as_ref().llt(Side::Lower) {
-        Ok(l) => l.solve(&rhs),
-        Err(_) => a.as_ref().partial_piv_lu().solve(&rhs),
-    };
+    let triplets: Vec<Triplet<usize, usize, f64>> = entries
+        .into_iter()
+        .map(|((r, c), v)| Triplet::new(r, c, v))
+        .collect();
+    let sol = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &triplets)
+        .ok()
+        .and_then(|a| a.sp_cholesky(Side::Lower).ok())
+        .map(|l| l.solve(&rhs))
+        .unwrap_or_else(|| Mat::zeros(m, 2));
     for i in 0..m {
         curve.points[i] = [sol[(i, 0)], sol[(i, 1)]];
     }

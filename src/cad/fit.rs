@@ -13,6 +13,7 @@
 //! curve, and its deviation is the true distance from each boundary point to the curve.
 
 use super::bspline::{fit, Periodic, P2};
+use rayon::prelude::*;
 
 /// A fitted loop.
 #[derive(Debug, Clone)]
@@ -45,14 +46,18 @@ fn fit_with_knots(
     let mut params = params0.to_vec();
     let mut curve = fit(pts, &params, knots.clone(), period);
     let mut dist = vec![0.0; pts.len()];
-    for round in 0..3 {
+    for round in 0..2 {
         let window = period / (2.0 * knots.len() as f64);
-        for (k, p) in pts.iter().enumerate() {
-            let (u, d) = curve.project(*p, params[k], window);
+        let res: Vec<(f64, f64)> = pts
+            .par_iter()
+            .zip(params.par_iter())
+            .map(|(p, &u)| curve.project(*p, u, window))
+            .collect();
+        for (k, (u, d)) in res.into_iter().enumerate() {
             params[k] = u;
             dist[k] = d;
         }
-        if round < 2 {
+        if round == 0 {
             curve = fit(pts, &params, knots.clone(), period);
         }
     }
@@ -71,18 +76,50 @@ fn max(v: &[f64]) -> f64 {
 pub fn uniform(pts: &[P2], tol: f64) -> Fitted {
     let (params, period) = chord_params(pts);
     let hi_limit = (pts.len() / 2).max(4);
+    // Corrected parameters of one fit are a good start for the next.
+    let shared = std::sync::Mutex::new(params.clone());
     let try_m = |m: usize| {
-        let (c, _, d) = fit_with_knots(pts, &params, uniform_knots(m, period), period);
+        let start = shared
+            .lock()
+            .map(|p| p.clone())
+            .unwrap_or_else(|_| params.clone());
+        let (c, prm, d) = fit_with_knots(pts, &start, uniform_knots(m, period), period);
+        if let Ok(mut p) = shared.lock() {
+            *p = prm;
+        }
         (c, max(&d))
     };
-    // Grow until it fits, then bisect between the last failure and the first success.
-    let mut lo = 3usize; // fails by convention
-    let mut hi = 4usize;
-    let mut best = try_m(hi);
-    while best.1 > tol && hi < hi_limit {
-        lo = hi;
-        hi = (hi * 2).min(hi_limit);
-        best = try_m(hi);
+    // From a guess, step by factors of two to bracket the smallest fitting count, then bisect.
+    let mut m = (pts.len() / 24).clamp(4, hi_limit);
+    let mut r = try_m(m);
+    let (mut lo, mut hi, mut best);
+    if r.1 <= tol {
+        hi = m;
+        best = r;
+        lo = 3; // fails by convention
+        while hi > 4 {
+            m = (hi / 2).max(4);
+            r = try_m(m);
+            if r.1 <= tol {
+                hi = m;
+                best = r;
+            } else {
+                lo = m;
+                break;
+            }
+        }
+    } else {
+        lo = m;
+        loop {
+            m = (m * 2).min(hi_limit);
+            r = try_m(m);
+            if r.1 <= tol || m == hi_limit {
+                hi = m;
+                best = r;
+                break;
+            }
+            lo = m;
+        }
     }
     while hi - lo > 1 {
         let mid = (lo + hi) / 2;
@@ -128,14 +165,14 @@ pub fn adaptive(pts: &[P2], tol: f64, u: &Fitted) -> Fitted {
     let mut sorted = v.clone();
     sorted.sort_by(|a, b| b.total_cmp(a));
     let mut best: Option<Fitted> = None;
-    for q in [0.05, 0.1, 0.2, 0.3, 0.45] {
+    for q in [0.08, 0.18, 0.35] {
         let thr = sorted[((q * ns as f64) as usize).min(ns - 1)];
         // Knots at samples above the threshold, at most one per uniform span.
         let mut knots: Vec<f64> = Vec::new();
         let min_gap = period / mu as f64 * 0.999;
-        for i in 0..ns {
+        for (i, &vi) in v.iter().enumerate() {
             let t = i as f64 * du;
-            if v[i] >= thr && knots.last().is_none_or(|&l| t - l >= min_gap) {
+            if vi >= thr && knots.last().is_none_or(|&l| t - l >= min_gap) {
                 knots.push(t);
             }
         }

@@ -82,7 +82,10 @@ pub struct TopoArgs {
     /// PNG images of the stages: PREFIX-raw.png, -thresholded, -skeleton, -final.
     #[arg(long, value_name = "PREFIX")]
     pub images: Option<PathBuf>,
-    /// Cleaned densities on the refined grid (.npy).
+    /// Boundary points of the 2D result (CSV: loop, x, y in mm), the points the curves fit.
+    #[arg(long, value_name = "FILE.csv")]
+    pub boundary: Option<PathBuf>,
+    /// Cleaned solid on the refined grid (.npy of 0/1, the input's layout).
     #[arg(long, value_name = "FILE.npy")]
     pub cleaned: Option<PathBuf>,
     /// Skip CGAL's self-intersection test.
@@ -169,6 +172,17 @@ pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
     }
     if let Some(p) = &a.dxf {
         latvox::output::write_atomic(p, |w| latvox::cad::dxf::write(w, &r.adaptive))?;
+    }
+    if let Some(p) = &a.boundary {
+        latvox::output::write_atomic(p, |w| {
+            writeln!(w, "loop,x,y")?;
+            for (k, l) in r.loops.iter().enumerate() {
+                for q in l {
+                    writeln!(w, "{k},{:.9},{:.9}", q[0], q[1])?;
+                }
+            }
+            Ok(())
+        })?;
     }
     if let Some(p) = &a.cleaned {
         let f = &r.cleaned.field;

@@ -151,6 +151,12 @@ pub fn clean(d: &Density, o: &CleanOptions) -> Result<Cleaned> {
         };
         field = raised.cone_filter(radius_px);
         level = field.level_for_count(target);
+        // The 2D outline is the contour of the field, whose area differs from the pixel count
+        // by a fraction of a pixel along the boundary: the level keeps the area. (In 3D the job
+        // matches the meshed volume after the loop.)
+        if !field.is_3d() {
+            level = level_for_area(&field, level, target as f64 * field.h * field.h);
+        }
         mask = field.threshold(level);
         last = analyse(&field, &mask, o.min_feature);
         last.lost = super::features::lost(field.n, &mask, &medial);
@@ -169,22 +175,6 @@ pub fn clean(d: &Density, o: &CleanOptions) -> Result<Cleaned> {
         }
         flagged = last.clone();
         flagged_mask = mask.clone();
-    }
-    // The outline (2D) is the contour of the field, whose area differs from the pixel count by
-    // a fraction of a pixel along the boundary: move the level so the outline keeps the area.
-    if !field.is_3d() {
-        let goal = target as f64 * field.h * field.h;
-        let t = level_for_area(&field, level, goal);
-        if t != level {
-            let m = field.threshold(t);
-            let mut a = analyse(&field, &m, o.min_feature);
-            a.lost = super::features::lost(field.n, &m, &medial);
-            if a.is_clean() || !last.is_clean() {
-                level = t;
-                mask = m;
-                last = a;
-            }
-        }
     }
     Ok(Cleaned {
         raw,
@@ -293,20 +283,26 @@ fn raise(
 /// The level near `start` at which the contour of `f` encloses `goal` mm² (secant iteration).
 fn level_for_area(f: &Raster, start: f64, goal: f64) -> f64 {
     use super::contour::{loops, signed_area};
-    let area = |t: f64| -> f64 { loops(f, t).iter().map(signed_area).sum() };
-    let (mut t0, mut a0) = (start, area(start));
-    let (mut t1, mut a1) = (start - 0.01, area(start - 0.01));
-    for _ in 0..8 {
-        if (a1 - goal).abs() <= 1e-5 * goal || a1 == a0 {
+    secant(|t| loops(f, t).iter().map(signed_area).sum(), start, goal)
+}
+
+/// The level near `start` at which `measure` is `goal` (secant iteration, at most six steps);
+/// `start` itself if no step improves on it.
+pub(crate) fn secant(mut measure: impl FnMut(f64) -> f64, start: f64, goal: f64) -> f64 {
+    let m0 = measure(start);
+    let (mut t0, mut a0) = (start, m0);
+    let (mut t1, mut a1) = (start - 0.01, measure(start - 0.01));
+    for _ in 0..6 {
+        if (a1 - goal).abs() <= 1e-4 * goal || a1 == a0 {
             break;
         }
         let t2 = (t1 - (a1 - goal) * (t1 - t0) / (a1 - a0)).clamp(start - 0.2, start + 0.2);
         t0 = t1;
         a0 = a1;
         t1 = t2;
-        a1 = area(t1);
+        a1 = measure(t1);
     }
-    if (a1 - goal).abs() < (area(start) - goal).abs() {
+    if (a1 - goal).abs() < (m0 - goal).abs() {
         t1
     } else {
         start

@@ -56,7 +56,7 @@ pub fn loops(f: &Raster, level: f64) -> Vec<Loop> {
             let exits: Vec<usize> = (0..4).filter(|&k| c[k] && !c[(k + 1) % 4]).collect();
             let entries: Vec<usize> = (0..4).filter(|&k| !c[k] && c[(k + 1) % 4]).collect();
             if exits.len() == 1 {
-                next[e[exits[0]] as usize] = e[entries[0]] as u32;
+                next[e[exits[0]]] = e[entries[0]] as u32;
             } else {
                 // Saddle: two solid corners on a diagonal.
                 let centre = 0.25 * (val(i, j) + val(i + 1, j) + val(i + 1, j + 1) + val(i, j + 1));
@@ -156,7 +156,7 @@ mod tests {
         let mut data = vec![0.0; n * n];
         for j in 0..n {
             for i in 0..n {
-                let r = (((i as f64 - 19.5).powi(2) + (j as f64 - 19.5).powi(2)) as f64).sqrt();
+                let r = ((i as f64 - 19.5).powi(2) + (j as f64 - 19.5).powi(2)).sqrt();
                 data[j * n + i] = if (8.0..15.0).contains(&r) { 1.0 } else { 0.0 };
             }
         }

@@ -21,9 +21,17 @@ pub fn extrude(loops: &[Loop], thickness: f64) -> Result<Mesh> {
         .flat_map(|l| l.windows(2))
         .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
         .fold(0.0f64, f64::max);
+    // Coordinates are rounded to single precision first, so the caps are triangulated on
+    // exactly the points the STL will hold.
     let loops: Vec<Loop> = loops
         .iter()
-        .map(|l| simplified(l, 0.05 * scale, 1e-3 * scale))
+        .map(|l| {
+            let l: Loop = l
+                .iter()
+                .map(|p| [p[0] as f32 as f64, p[1] as f32 as f64])
+                .collect();
+            simplified(&l, 0.05 * scale, 1e-3 * scale)
+        })
         .collect();
     let loops = &loops[..];
     let total: usize = loops.iter().map(Vec::len).sum();
@@ -51,6 +59,7 @@ pub fn extrude(loops: &[Loop], thickness: f64) -> Result<Mesh> {
         }
     }
     let mut ec = earcut::Earcut::new();
+    let mut refiner = earcut::Refiner::new();
     let mut tris: Vec<u32> = Vec::new();
     for (outer, holes) in polygons(loops) {
         let mut data: Vec<[f64; 2]> = loops[outer].clone();
@@ -64,8 +73,11 @@ pub fn extrude(loops: &[Loop], thickness: f64) -> Result<Mesh> {
             map.extend((0..loops[h].len()).map(|k| (starts[h] + k) as u32));
         }
         ec.earcut(data.iter().copied(), &hole_idx, &mut tris);
+        // Lawson flips towards a Delaunay triangulation: fewer slivers, which single precision
+        // and the self-intersection test both prefer.
+        refiner.refine(&mut tris, &data);
         let dev = earcut::deviation(data.iter().copied(), &hole_idx, &tris);
-        if !(dev < 1e-6) {
+        if dev.is_nan() || dev >= 1e-6 {
             return Err(Error::invalid(format!(
                 "triangulating a cap failed (area deviation {dev:e})"
             )));
@@ -114,7 +126,7 @@ fn simplified(l: &Loop, min_len: f64, min_dev: f64) -> Loop {
         let mut out = Vec::with_capacity(n);
         let mut skipped_last = false;
         for i in 0..n {
-            if !keep[i] && !skipped_last && !(i + 1 == n && !keep[0]) {
+            if !keep[i] && !skipped_last && (i + 1 != n || keep[0]) {
                 skipped_last = true;
                 continue;
             }

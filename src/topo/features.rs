@@ -1,6 +1,6 @@
 //! What makes a thresholded density field unprintable, found on the refined grid:
 //! - **thin features** (seed 003, step 1.3): in 2D, skeleton pixels whose inscribed radius is
-//!   below `l_limit / 2`; in 3D, solid voxels that no ball of radius `l_limit / 2` inside the
+//!   below `l_limit / 2` (to within half a pixel); in 3D, solid voxels that no ball of radius `l_limit / 2` inside the
 //!   solid covers (the residue of a morphological opening computed with distance transforms),
 //!   ignoring the thin rim such an opening always leaves along convex edges and corners;
 //! - **islands**: solid parts not face-connected to the main (largest) body;
@@ -118,7 +118,9 @@ pub fn analyse(grid: &Raster, mask: &Mask, min_feature: f64) -> Analysis {
         for (i, &s) in skel.iter().enumerate() {
             if s {
                 a.min_radius_mm = a.min_radius_mm.min(radius[i] * grid.h);
-                if radius[i] < half {
+                // The pixel-centre distance is within half a pixel of the true inscribed radius
+                // (under for odd widths, over for even): members down to l_limit − h pass.
+                if radius[i] + 0.5 < half {
                     a.thin.push(i);
                 }
             }
@@ -131,8 +133,8 @@ pub fn analyse(grid: &Raster, mask: &Mask, min_feature: f64) -> Analysis {
 }
 
 fn thin_3d(n: [usize; 3], mask: &Mask, d2: &[f64], half: f64, a: &mut Analysis) {
-    // Centres of balls of radius ≥ l/2 inside the solid (distance to void ≥ l/2 + ½ voxel).
-    let r = half + 0.5;
+    // Centres of balls of radius l/2 inside the solid, to within half a voxel (as in 2D).
+    let r = half;
     let centres: Vec<bool> = d2.iter().map(|&d| d >= r * r).collect();
     let to_centre = edt_squared(n, &centres, false);
     // Covered: within r of such a centre. Residue: solid and not covered.

@@ -116,7 +116,7 @@ fn defects(a: &super::features::Analysis, is_3d: bool) -> Defects {
 pub fn run(d: &Density, job: &TopoJob, progress: &Progress) -> Result<TopoResult> {
     let t0 = Instant::now();
     let mut timings = Timings::default();
-    let cleaned = {
+    let mut cleaned = {
         let _s = progress.stage("cleaning the density field");
         clean(d, &job.clean)?
     };
@@ -130,7 +130,27 @@ pub fn run(d: &Density, job: &TopoJob, progress: &Progress) -> Result<TopoResult
     let (mesh, loops) = {
         let _s = progress.stage("meshing");
         if d.is_3d {
-            (volume::mesh(&cleaned.field, cleaned.level)?, Vec::new())
+            // The iso-surface encloses less than the voxels it was thresholded from (thin
+            // members most): move the level until the mesh keeps the thresholded volume.
+            let mut meshed = Vec::new();
+            let level = super::clean::secant(
+                |t| match volume::mesh(&cleaned.field, t) {
+                    Ok(m) => {
+                        let v = m.volume();
+                        meshed.push((t, m));
+                        v
+                    }
+                    Err(_) => f64::NAN,
+                },
+                cleaned.level,
+                thresholded_measure,
+            );
+            let mesh = match meshed.into_iter().find(|(t, _)| *t == level) {
+                Some((_, m)) => m,
+                None => volume::mesh(&cleaned.field, level)?,
+            };
+            cleaned.level = level;
+            (mesh, Vec::new())
         } else {
             let loops = contour::loops(&cleaned.field, cleaned.level);
             (extrude::extrude(&loops, job.thickness)?, loops)

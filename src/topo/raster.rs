@@ -63,7 +63,8 @@ impl Raster {
     /// (step 2.4: re-threshold at the level that keeps the volume).
     pub fn level_for_count(&self, target: usize) -> f64 {
         let count = |t: f64| self.data.par_iter().filter(|&&v| v >= t).count();
-        let (mut lo, mut hi) = (0.0f64, 1.0f64 + 1e-9);
+        let top = self.data.iter().copied().fold(1.0f64, f64::max);
+        let (mut lo, mut hi) = (0.0f64, top + 1e-9);
         // count(lo) ≥ target ≥ count(hi); the count falls as t rises.
         for _ in 0..60 {
             let mid = 0.5 * (lo + hi);
@@ -105,7 +106,7 @@ impl Raster {
             }
         }
         let [nx, ny, nz] = self.n;
-        let (nxi, nyi, nzi) = (nx as isize, ny as isize, nz as isize);
+        let (nyi, nzi) = (ny as isize, nz as isize);
         // Row-wise min and max over the x-window, to find constant windows cheaply.
         let win = |v: &[f64], f: fn(f64, f64) -> f64| -> Vec<f64> {
             let mut out = vec![0.0; v.len()];
@@ -122,12 +123,14 @@ impl Raster {
             .map(|v| (win(v, f64::min), win(v, f64::max)))
             .collect();
         let src = &self.data;
+        let width = 2 * ri as usize + 1;
         let mut out = vec![0.0; src.len()];
         out.par_chunks_mut(nx).enumerate().for_each(|(row, o)| {
             let (y, z) = ((row % ny) as isize, (row / ny) as isize);
             let mut lo = vec![f64::INFINITY; nx];
             let mut hi = vec![f64::NEG_INFINITY; nx];
-            for (dz, dy, _) in &offsets {
+            let mut taps: Vec<(usize, &[f64])> = Vec::with_capacity(offsets.len());
+            for (dz, dy, wrow) in &offsets {
                 let (yy, zz) = (y + dy, z + dz);
                 if yy < 0 || yy >= nyi || zz < 0 || zz >= nzi {
                     continue;
@@ -137,29 +140,64 @@ impl Raster {
                     lo[x] = lo[x].min(rows[r2].0[x]);
                     hi[x] = hi[x].max(rows[r2].1[x]);
                 }
+                taps.push((r2 * nx, wrow.as_slice()));
             }
-            for x in 0..nx {
+            // Runs of pixels whose window is not constant: 1D convolutions row by row, on a
+            // zero-padded copy so the inner loop has no bounds tests.
+            let mut padded = vec![0.0; nx + width];
+            let mut acc = vec![0.0; nx];
+            // Weight sums: the row sums of the taps inside the domain; fewer near its x ends.
+            let interior: f64 = taps.iter().map(|(_, w)| w.iter().sum::<f64>()).sum();
+            let mut wsum = vec![interior; nx];
+            for x in (0..ri.min(nx as isize)).chain((nx as isize - ri).max(0)..nx as isize) {
+                wsum[x as usize] = taps
+                    .iter()
+                    .flat_map(|(_, w)| w.iter().enumerate())
+                    .filter(|(k, _)| {
+                        let xs = x + *k as isize - ri;
+                        xs >= 0 && xs < nx as isize
+                    })
+                    .map(|(_, w)| w)
+                    .sum();
+            }
+            let mut x = 0;
+            while x < nx {
                 if lo[x] == hi[x] {
                     o[x] = lo[x];
+                    x += 1;
                     continue;
                 }
-                let (mut s, mut ws) = (0.0, 0.0);
-                for (dz, dy, wrow) in &offsets {
-                    let (yy, zz) = (y + dy, z + dz);
-                    if yy < 0 || yy >= nyi || zz < 0 || zz >= nzi {
-                        continue;
+                let start = x;
+                while x < nx && lo[x] != hi[x] {
+                    x += 1;
+                }
+                let (a, b) = (start, x);
+                acc[a..b].iter_mut().for_each(|v| *v = 0.0);
+                for &(base, wrow) in &taps {
+                    let line = &src[base..base + nx];
+                    // padded[k] = line[k − ri], zero outside the row.
+                    let (pa, pb) = (a, (b + width - 1).min(nx + width));
+                    for (k, pk) in padded.iter_mut().enumerate().take(pb).skip(pa) {
+                        let xs = k as isize - ri;
+                        *pk = if xs >= 0 && (xs as usize) < nx {
+                            line[xs as usize]
+                        } else {
+                            0.0
+                        };
                     }
-                    let base = ((zz * nyi + yy) * nxi) as usize;
-                    let xi = x as isize;
                     for (k, &w) in wrow.iter().enumerate() {
-                        let xx = xi + k as isize - ri;
-                        if w > 0.0 && xx >= 0 && xx < nxi {
-                            s += w * src[base + xx as usize];
-                            ws += w;
+                        if w == 0.0 {
+                            continue;
+                        }
+                        let src_k = &padded[a + k..b + k];
+                        for (acc, &v) in acc[a..b].iter_mut().zip(src_k) {
+                            *acc += w * v;
                         }
                     }
                 }
-                o[x] = s / ws;
+                for k in a..b {
+                    o[k] = acc[k] / wsum[k];
+                }
             }
         });
         Raster {

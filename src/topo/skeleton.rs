@@ -50,6 +50,8 @@ fn transitions(p: &[bool; 8]) -> usize {
 }
 
 /// Zhang–Suen thinning of `mask` (`nx × ny`, x fastest): the skeleton pixels' indices.
+// The deletion conditions are written as in Zhang & Suen's paper.
+#[allow(clippy::nonminimal_bool)]
 pub fn thin(nx: usize, ny: usize, mask: &[bool]) -> Vec<bool> {
     let mut on = mask.to_vec();
     let mut flagged = vec![false; on.len()];
@@ -66,7 +68,7 @@ pub fn thin(nx: usize, ny: usize, mask: &[bool]) -> Vec<bool> {
     let mut step = 0usize;
     let mut idle = 0;
     while idle < 2 && !cand.is_empty() {
-        let first = step % 2 == 0;
+        let first = step.is_multiple_of(2);
         step += 1;
         let del: Vec<usize> = {
             let img = Img { nx, ny, on: &on };

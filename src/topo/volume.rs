@@ -3,13 +3,13 @@
 //! narrow-band level set by [`Grid::sample`] and meshed by [`Grid::to_mesh`].
 //!
 //! Value: `(level − ρ) / |∇ρ|`, a first-order signed distance to the iso-surface `ρ = level`.
-//! Clearance: with ρ clamped to [0, 1] each partial derivative of the trilinear interpolant is at
-//! most `1/h`, so `|∇ρ| ≤ √3/h` and the surface is at least `|ρ − level|·h/√3` away — a bound
-//! that never overestimates, as block culling requires.
+//! Clearance: with ρ in [0, top] each partial derivative of the trilinear interpolant is at most
+//! `top/h`, so `|∇ρ| ≤ √3·top/h` and the surface is at least `|ρ − level|·h/(√3·top)` away — a
+//! bound that never overestimates, as block culling requires.
 
 use super::raster::Raster;
 use crate::error::Result;
-use crate::field::{Aabb, Field, Vec3};
+use crate::field::{Aabb, Field, Intersection, Vec3};
 use crate::grid::{Grid, GridSpec};
 use crate::mesh::Mesh;
 
@@ -17,6 +17,8 @@ use crate::mesh::Mesh;
 pub struct DensityField<'a> {
     pub grid: &'a Raster,
     pub level: f64,
+    /// Largest density (raised features may exceed 1): the gradient bound scales with it.
+    pub top: f64,
 }
 
 impl DensityField<'_> {
@@ -26,7 +28,7 @@ impl DensityField<'_> {
         {
             return 0.0;
         }
-        self.grid.data[(k as usize * n[1] + j as usize) * n[0] + i as usize].clamp(0.0, 1.0)
+        self.grid.data[(k as usize * n[1] + j as usize) * n[0] + i as usize].max(0.0)
     }
 
     /// Trilinear density and its gradient (per mm).
@@ -63,8 +65,27 @@ impl DensityField<'_> {
     }
 }
 
+impl DensityField<'_> {
+    /// Distance from `p` to the domain box when outside it (0 inside).
+    fn outside(&self, p: Vec3) -> f64 {
+        let mut s = 0.0;
+        for (a, &c) in p.iter().enumerate() {
+            let hi = self.grid.n[a] as f64 * self.grid.h;
+            let d = (-c).max(c - hi).max(0.0);
+            s += d * d;
+        }
+        s.sqrt()
+    }
+}
+
 impl Field for DensityField<'_> {
     fn value(&self, p: Vec3) -> f64 {
+        // Beyond the domain the part is clipped away: the distance to the box is a lower bound
+        // and ramps up steadily, so the narrow band closes the part along the domain's faces.
+        let out = self.outside(p);
+        if out > 0.0 {
+            return out;
+        }
         let (v, g) = self.interp(p);
         let gn = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
         let bound = self.clearance(p);
@@ -82,20 +103,28 @@ impl Field for DensityField<'_> {
     }
 
     fn clearance(&self, p: Vec3) -> f64 {
+        let out = self.outside(p);
+        if out > 0.0 {
+            return out;
+        }
         let (v, _) = self.interp(p);
-        (v - self.level).abs() * self.grid.h / 3f64.sqrt()
+        (v - self.level).abs() * self.grid.h / (3f64.sqrt() * self.top)
     }
 }
 
 /// Meshes the iso-surface of a 3D raster at `level` with OpenVDB, at the raster's voxel size.
 pub fn mesh(grid: &Raster, level: f64) -> Result<Mesh> {
-    let f = DensityField { grid, level };
+    let top = grid.data.iter().copied().fold(1.0f64, f64::max);
+    let f = DensityField { grid, level, top };
     let h = grid.h;
     let bounds = Aabb {
         min: [0.0; 3],
         max: [0, 1, 2].map(|a| grid.n[a] as f64 * h),
     };
     let spec = GridSpec::covering(&bounds, h, 3.0);
-    let g = Grid::sample(&f, spec)?;
+    // Clipped by the domain box, whose exact distance closes the part where it meets the
+    // domain's faces (the density alone drops to void there without a distance-like ramp).
+    let clipped = Intersection { a: f, b: bounds };
+    let g = Grid::sample(&clipped, spec)?;
     g.to_mesh(0.0)
 }
