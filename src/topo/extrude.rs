@@ -30,7 +30,7 @@ pub fn extrude(loops: &[Loop], thickness: f64) -> Result<Mesh> {
                 .iter()
                 .map(|p| [p[0] as f32 as f64, p[1] as f32 as f64])
                 .collect();
-            simplified(&l, 0.05 * scale, 1e-3 * scale)
+            simplified(&l, 0.05 * scale, 5e-3 * scale)
         })
         .collect();
     let loops = &loops[..];
