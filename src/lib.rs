@@ -8,6 +8,7 @@
 
 pub mod cad;
 pub mod error;
+pub mod extract;
 pub(crate) mod ffi;
 pub mod field;
 pub mod grid;
