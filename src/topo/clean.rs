@@ -288,15 +288,32 @@ fn level_for_area(f: &Raster, start: f64, goal: f64) -> f64 {
 
 /// The level near `start` at which `measure` is `goal` (secant iteration, at most six steps);
 /// `start` itself if no step improves on it.
-pub(crate) fn secant(mut measure: impl FnMut(f64) -> f64, start: f64, goal: f64) -> f64 {
+pub(crate) fn secant(measure: impl FnMut(f64) -> f64, start: f64, goal: f64) -> f64 {
+    secant_in(
+        measure,
+        start,
+        goal,
+        [(start - 0.45).max(1e-3), start + 0.45],
+        0.01,
+    )
+}
+
+/// [`secant`] within `range`, with `step` for the first trial.
+pub(crate) fn secant_in(
+    mut measure: impl FnMut(f64) -> f64,
+    start: f64,
+    goal: f64,
+    range: [f64; 2],
+    step: f64,
+) -> f64 {
     let m0 = measure(start);
     let (mut t0, mut a0) = (start, m0);
-    let (mut t1, mut a1) = (start - 0.01, measure(start - 0.01));
+    let (mut t1, mut a1) = (start - step, measure(start - step));
     for _ in 0..6 {
         if (a1 - goal).abs() <= 1e-4 * goal || a1 == a0 {
             break;
         }
-        let t2 = (t1 - (a1 - goal) * (t1 - t0) / (a1 - a0)).clamp(start - 0.2, start + 0.2);
+        let t2 = (t1 - (a1 - goal) * (t1 - t0) / (a1 - a0)).clamp(range[0], range[1]);
         t0 = t1;
         a0 = a1;
         t1 = t2;

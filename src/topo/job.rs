@@ -25,6 +25,9 @@ pub struct TopoJob {
     /// Fit the CAD curves (2D only).
     pub fit_curves: bool,
     pub self_intersection: bool,
+    /// 3D: OpenVDB level-set smoothing passes (0: none) and the flow.
+    pub smooth_iterations: u32,
+    pub smoothing: volume::Smoothing,
 }
 
 /// One boundary loop's fits.
@@ -129,7 +132,35 @@ pub fn run(d: &Density, job: &TopoJob, progress: &Progress) -> Result<TopoResult
     let t = Instant::now();
     let (mesh, loops) = {
         let _s = progress.stage("meshing");
-        if d.is_3d {
+        if d.is_3d && job.smooth_iterations > 0 {
+            // Smooth once, then offset the smoothed surface until it keeps the volume.
+            let s = volume::Smoothed::new(
+                &cleaned.field,
+                cleaned.level,
+                job.smoothing,
+                job.smooth_iterations,
+            )?;
+            let mut meshed = Vec::new();
+            let offset = super::clean::secant_in(
+                |t| match s.mesh(t) {
+                    Ok(m) => {
+                        let v = m.volume();
+                        meshed.push((t, m));
+                        v
+                    }
+                    Err(_) => f64::NAN,
+                },
+                0.0,
+                thresholded_measure,
+                [-3.0 * h, 3.0 * h],
+                0.1 * h,
+            );
+            let mesh = match meshed.into_iter().find(|(t, _)| *t == offset) {
+                Some((_, m)) => m,
+                None => s.mesh(offset)?,
+            };
+            (mesh, Vec::new())
+        } else if d.is_3d {
             // The iso-surface encloses less than the voxels it was thresholded from (thin
             // members most): move the level until the mesh keeps the thresholded volume.
             let mut meshed = Vec::new();

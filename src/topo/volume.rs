@@ -1,4 +1,5 @@
-//! 3D results to a mesh through latvox's own pipeline: the filtered density grid is a
+//! 3D results to a mesh through latvox's own pipeline (optionally smoothed by OpenVDB's
+//! level-set filter, [`smoothed_mesh`]): the filtered density grid is a
 //! [`Field`] (trilinear between voxel centres, void beyond the domain), sampled into an OpenVDB
 //! narrow-band level set by [`Grid::sample`] and meshed by [`Grid::to_mesh`].
 //!
@@ -8,10 +9,11 @@
 //! bound that never overestimates, as block culling requires.
 
 use super::raster::Raster;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::field::{Aabb, Field, Intersection, Vec3};
 use crate::grid::{Grid, GridSpec};
 use crate::mesh::Mesh;
+use rayon::prelude::*;
 
 /// The iso-surface `ρ = level` of a 3D raster.
 pub struct DensityField<'a> {
@@ -127,4 +129,73 @@ pub fn mesh(grid: &Raster, level: f64) -> Result<Mesh> {
     let clipped = Intersection { a: f, b: bounds };
     let g = Grid::sample(&clipped, spec)?;
     g.to_mesh(0.0)
+}
+
+/// OpenVDB's level-set smoothing flows (`LevelSetFilter`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Smoothing {
+    Gaussian,
+    MeanCurvature,
+    Laplacian,
+    Mean,
+}
+
+/// A 3D raster's iso-surface at `level`, smoothed by `iterations` passes of OpenVDB's level-set
+/// filter: the density field, sampled as a [`Field`] at the voxel centres, is rebuilt by OpenVDB
+/// as a narrow-band level set and smoothed (`cpp/vdb_filter.cc`). Mesh it with
+/// [`Smoothed::mesh`] at any offset of the surface.
+pub struct Smoothed {
+    inner: cxx::UniquePtr<crate::ffi::vdb_filter::ffi::SmoothedLevelSet>,
+}
+
+impl Smoothed {
+    pub fn new(grid: &Raster, level: f64, mode: Smoothing, iterations: u32) -> Result<Smoothed> {
+        let top = grid.data.iter().copied().fold(1.0f64, f64::max);
+        let f = DensityField { grid, level, top };
+        let [nx, ny, nz] = grid.n;
+        let h = grid.h;
+        let values: Vec<f32> = (0..nx * ny * nz)
+            .into_par_iter()
+            .map(|i| {
+                let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
+                f.value([
+                    (x as f64 + 0.5) * h,
+                    (y as f64 + 0.5) * h,
+                    (z as f64 + 0.5) * h,
+                ]) as f32
+            })
+            .collect();
+        let mode = match mode {
+            Smoothing::Gaussian => 1,
+            Smoothing::MeanCurvature => 2,
+            Smoothing::Laplacian => 3,
+            Smoothing::Mean => 4,
+        };
+        let dims = [nx as u32, ny as u32, nz as u32];
+        let inner = crate::ffi::vdb_filter::ffi::vdb_smooth(
+            &values,
+            &dims,
+            h,
+            &[0.0; 3],
+            (3.0 * h) as f32,
+            mode,
+            iterations,
+        )
+        .map_err(|e| Error::backend("smoothing the level set (OpenVDB LevelSetFilter)", e))?;
+        Ok(Smoothed { inner })
+    }
+
+    /// The smoothed surface offset outwards by `offset` mm (negative: inwards), meshed.
+    pub fn mesh(&self, offset: f64) -> Result<Mesh> {
+        let (mut positions, mut indices) = (Vec::new(), Vec::new());
+        crate::ffi::vdb_filter::ffi::vdb_smoothed_mesh(
+            &self.inner,
+            offset,
+            &mut positions,
+            &mut indices,
+        )
+        .map_err(|e| Error::backend("meshing the smoothed level set", e))?;
+        Ok(Mesh { positions, indices })
+    }
 }
