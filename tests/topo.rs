@@ -291,8 +291,8 @@ fn three_d_field_meshes_closed_through_openvdb() {
     );
     let rep = d.join("r.json");
     let stl = d.join("c3.stl");
-    ok(
-        &[
+    let topo3d = |out: &Path, extra: &[&str]| {
+        let mut a = vec![
             "topo",
             npy.to_str().unwrap(),
             "--element-size",
@@ -301,15 +301,21 @@ fn three_d_field_meshes_closed_through_openvdb() {
             "4",
             "--min-feature",
             "2",
+            "-q",
             "-o",
-            stl.to_str().unwrap(),
+            out.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        ok(&a, d)
+    };
+    topo3d(
+        &stl,
+        &[
             "--report",
             rep.to_str().unwrap(),
             "--images",
             d.join("s").to_str().unwrap(),
-            "-q",
         ],
-        d,
     );
     let r = json(&rep);
     assert_eq!(r["clean"], true);
@@ -336,24 +342,7 @@ fn three_d_field_meshes_closed_through_openvdb() {
     // Two passes of OpenVDB's Gaussian level-set filter: still closed, same volume, and a
     // smoother surface — less area for the same volume.
     let smooth = d.join("smooth.stl");
-    ok(
-        &[
-            "topo",
-            npy.to_str().unwrap(),
-            "--element-size",
-            "2",
-            "--refine",
-            "4",
-            "--min-feature",
-            "2",
-            "--smooth",
-            "2",
-            "-o",
-            smooth.to_str().unwrap(),
-            "-q",
-        ],
-        d,
-    );
+    topo3d(&smooth, &["--smooth", "2"]);
     let st = read_stl(&smooth);
     assert_eq!(edges(&st), Edges::default());
     let vs = volume(&st);
