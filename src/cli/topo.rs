@@ -18,8 +18,8 @@ Examples:
   # A 3D field (shape ny, nx, nz) straight to a closed STL through OpenVDB
   latvox topo bracket3d.npy --element-size 1 --refine 2 --min-feature 1.5 -o bracket.stl
 
-  # The same, smoothed by four passes of OpenVDB's Gaussian level-set filter
-  latvox topo bracket3d.npy --element-size 1 --refine 2 --smooth 4 -o bracket-smooth.stl
+  # The same, smoothed by two passes of OpenVDB's Gaussian level-set filter
+  latvox topo bracket3d.npy --element-size 1 --refine 2 --smooth 2 -o bracket-smooth.stl
 
 Input: .npy (float, int or bool; C or Fortran order), .csv (2D, one row per line) or text with a
 dimension header line `ny nx [nz]` then the values. 2D arrays are (ny, nx) with row 0 at the
