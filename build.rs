@@ -38,6 +38,12 @@ fn main() {
     flags(&mut vdb);
     vdb.file("cpp/vdb.cc").compile("latvox_vdb");
 
+    let mut filter = cxx_build::bridge("src/ffi/vdb_filter.rs");
+    flags(&mut filter);
+    filter
+        .file("cpp/vdb_filter.cc")
+        .compile("latvox_vdb_filter");
+
     let mut cgal = cxx_build::bridge("src/ffi/cgal.rs");
     flags(&mut cgal);
     cgal.define("CGAL_LINKED_WITH_TBB", None)
@@ -54,6 +60,9 @@ fn main() {
         "cpp/vdb.cc",
         "cpp/cgal.h",
         "cpp/cgal.cc",
+        "src/ffi/vdb_filter.rs",
+        "cpp/vdb_filter.h",
+        "cpp/vdb_filter.cc",
     ] {
         println!("cargo:rerun-if-changed={f}");
     }

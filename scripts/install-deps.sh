@@ -9,6 +9,10 @@ PKGS=(
   libimath-dev libblosc-dev zlib1g-dev libboost-dev
   # tests: independent checkers
   admesh libopenvdb-tools
+  # tests (topo): Python for the published optimisers' reference transcriptions, and the
+  # libraries the PyPI gmsh wheel (OpenCASCADE, reads IGES back) links against
+  python3 python3-pip python3-venv libglu1-mesa libgl1 libopengl0 libxrender1 libxcursor1
+  libxfixes3 libxext6 libxft2 libfontconfig1 libxinerama1 libx11-6 libgomp1
 )
 
 if [ "$(id -u)" -eq 0 ]; then SUDO=(); else SUDO=(sudo); fi
@@ -25,4 +29,20 @@ if [ ${#missing[@]} -gt 0 ]; then
   "${SUDO[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 else
   echo "install-deps: all packages present" >&2
+fi
+
+# Python packages for the tests: NumPy/SciPy (reference optimisers, independent checks of the
+# cleaned fields), gmsh (OpenCASCADE reads the IGES back) and ezdxf (reads the DXF back).
+PY_PKGS=(numpy scipy gmsh ezdxf)
+if python3 -c "import numpy, scipy, gmsh, ezdxf" 2>/dev/null; then
+  echo "install-deps: Python packages present" >&2
+else
+  echo "install-deps: installing Python packages ${PY_PKGS[*]}" >&2
+  pip_install() { python3 -m pip install --quiet --disable-pip-version-check "$@" "${PY_PKGS[@]}"; }
+  if [ "$(id -u)" -eq 0 ] || [ -w "$(python3 -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')" ]; then
+    pip_install 2>/dev/null || pip_install --break-system-packages
+  else
+    pip_install --user 2>/dev/null || pip_install --user --break-system-packages
+  fi
+  python3 -c "import numpy, scipy, gmsh, ezdxf"
 fi

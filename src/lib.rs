@@ -3,8 +3,10 @@
 //! level sets and meshes them; CGAL verifies the result.
 //!
 //! Stages, one module each: [`field`] → [`grid`] → [`mesh`] → [`verify`] → [`stl`] (output).
-//! Capabilities: [`tpms`].
+//! Capabilities: [`tpms`], [`topopt`] (SIMP optimiser), [`topo`] (density fields to STL and CAD),
+//! [`cad`] (B-spline curves, IGES, DXF).
 
+pub mod cad;
 pub mod error;
 pub mod extract;
 pub(crate) mod ffi;
@@ -16,6 +18,8 @@ pub mod progress;
 pub mod sink;
 pub mod snap;
 pub mod stl;
+pub mod topo;
+pub mod topopt;
 pub mod tpms;
 pub mod verify;
 

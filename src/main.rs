@@ -32,6 +32,12 @@ enum Command {
     /// Check an STL with CGAL: closed, outward, self-intersections, volume, area.
     #[command(after_help = cli::check::EXAMPLES)]
     Check(cli::check::CheckArgs),
+    /// SIMP topology optimisation (88-line code in 2D, top3d in 3D): densities to .npy.
+    #[command(after_help = cli::topopt::EXAMPLES)]
+    Topopt(cli::topopt::TopoptArgs),
+    /// Density field to printable STL and parametric CAD (IGES, DXF): seed 003's pipeline.
+    #[command(after_help = cli::topo::EXAMPLES)]
+    Topo(cli::topo::TopoArgs),
 }
 
 fn main() {
@@ -75,6 +81,8 @@ fn main() {
     let result = match &cli.command {
         Command::Tpms(a) => cli::tpms::run(a, cli.quiet),
         Command::Check(a) => cli::check::run(a),
+        Command::Topopt(a) => cli::topopt::run(a, cli.quiet),
+        Command::Topo(a) => cli::topo::run(a, cli.quiet),
     };
     match result {
         Ok(code) => std::process::exit(code),

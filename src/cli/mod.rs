@@ -2,6 +2,8 @@
 //! Each subcommand lives in its own file and exposes `Args` (clap) and `run`.
 
 pub mod check;
+pub mod topo;
+pub mod topopt;
 pub mod tpms;
 
 use latvox::Result;

@@ -3,3 +3,4 @@
 
 pub(crate) mod cgal;
 pub(crate) mod vdb;
+pub(crate) mod vdb_filter;
