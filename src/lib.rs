@@ -3,8 +3,9 @@
 //! level sets and meshes them; CGAL verifies the result.
 //!
 //! Stages, one module each: [`field`] → [`grid`] → [`mesh`] → [`verify`] → [`stl`] (output).
-//! Capabilities: [`tpms`].
+//! Capabilities: [`tpms`], [`batch`] (many jobs, resumable, sharded over Slurm arrays).
 
+pub mod batch;
 pub mod error;
 pub(crate) mod ffi;
 pub mod field;

@@ -32,6 +32,9 @@ enum Command {
     /// Check an STL with CGAL: closed, outward, self-intersections, volume, area.
     #[command(after_help = cli::check::EXAMPLES)]
     Check(cli::check::CheckArgs),
+    /// Run many jobs from a TOML job file: sweeps, workers, resume after a kill, Slurm arrays.
+    #[command(after_help = cli::batch::EXAMPLES)]
+    Batch(cli::batch::BatchArgs),
 }
 
 fn main() {
@@ -75,6 +78,7 @@ fn main() {
     let result = match &cli.command {
         Command::Tpms(a) => cli::tpms::run(a, cli.quiet),
         Command::Check(a) => cli::check::run(a),
+        Command::Batch(a) => cli::batch::run(a, cli.quiet),
     };
     match result {
         Ok(code) => std::process::exit(code),

@@ -5,7 +5,7 @@ use super::{
 };
 use clap::Args;
 use latvox::stl::StlFormat;
-use latvox::tpms::{Domain, Structure, Surface, TpmsJob};
+use latvox::tpms::{Domain, Structure, Surface, TpmsJob, TpmsReport};
 use latvox::{Error, Result};
 use std::path::PathBuf;
 
@@ -111,6 +111,24 @@ fn domain(a: &TpmsArgs) -> Result<Domain> {
 }
 
 pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
+    // Fail on an unwritable destination before the work, not after.
+    if let Some(r) = &a.report {
+        latvox::output::check_writable(r)?;
+    }
+    let report = execute(a, &latvox::progress::Progress::new(quiet))?;
+    if let Some(r) = &a.report {
+        write_json(r, &report)?;
+    }
+    for w in &report.warnings {
+        eprintln!("latvox: warning: {w}");
+    }
+    print_tpms_summary(&report);
+    Ok(if passed(&report) { 0 } else { 1 })
+}
+
+/// Runs the job and writes its STL atomically; returns the report (output and write time
+/// filled in), for `run` to print and `latvox batch` to record.
+pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<TpmsReport> {
     let job = TpmsJob {
         surface: a.surface,
         structure: a.structure,
@@ -122,13 +140,8 @@ pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
         auto_resolution: !a.fixed_resolution,
         self_intersection: !a.no_self_intersection_check,
     };
-    // Fail on an unwritable destination before the work, not after.
     latvox::output::check_writable(&a.output)?;
-    if let Some(r) = &a.report {
-        latvox::output::check_writable(r)?;
-    }
-    let progress = latvox::progress::Progress::new(quiet);
-    let (mesh, mut report) = job.run(&progress)?;
+    let (mesh, mut report) = job.run(progress)?;
     let t = std::time::Instant::now();
     {
         let _p = progress.stage("writing STL");
@@ -142,24 +155,13 @@ pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
     report.timings.write = t.elapsed().as_secs_f64();
     report.timings.total += report.timings.write;
     report.output = Some(a.output.display().to_string());
-    if let Some(r) = &a.report {
-        write_json(r, &report)?;
-    }
-    for w in &report.warnings {
-        eprintln!("latvox: warning: {w}");
-    }
-    print_tpms_summary(&report);
-    Ok(
-        if report.checks.is_valid_solid()
-            || !report.checks.self_intersection_checked
-                && report.checks.closed
-                && report.checks.outward
-        {
-            0
-        } else {
-            1
-        },
-    )
+    Ok(report)
+}
+
+/// Whether the part passed CGAL's checks (those that were asked for).
+pub fn passed(r: &TpmsReport) -> bool {
+    r.checks.is_valid_solid()
+        || !r.checks.self_intersection_checked && r.checks.closed && r.checks.outward
 }
 
 fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
