@@ -9,6 +9,8 @@ PKGS=(
   libimath-dev libblosc-dev zlib1g-dev libboost-dev
   # tests: independent checkers
   admesh libopenvdb-tools
+  # tests: a one-node Slurm cluster for latvox batch (scripts/slurm-test.sh)
+  slurm-wlm munge
 )
 
 if [ "$(id -u)" -eq 0 ]; then SUDO=(); else SUDO=(sudo); fi
