@@ -111,6 +111,9 @@ pub fn write_atomic(
         body(&mut w).map_err(|e| Error::io(path, e))?;
         w.flush().map_err(|e| Error::io(path, e))?;
     }
+    // On disk before the rename: after a crash of the machine, not only of the process, the
+    // name holds the old file or the whole new one, never a new file with lost blocks.
+    tmp.as_file().sync_data().map_err(|e| Error::io(path, e))?;
     tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
     Ok(())
 }

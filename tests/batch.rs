@@ -10,10 +10,28 @@ use std::path::{Path, PathBuf};
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
+/// `latvox`, without the Slurm array identity the test run itself may have (a test run inside
+/// an array task would otherwise shard every batch).
+fn lv() -> std::process::Command {
+    let mut c = latvox();
+    for v in [
+        "SLURM_ARRAY_TASK_ID",
+        "SLURM_ARRAY_TASK_MIN",
+        "SLURM_ARRAY_TASK_MAX",
+        "SLURM_ARRAY_TASK_STEP",
+        "SLURM_ARRAY_TASK_COUNT",
+    ] {
+        c.env_remove(v);
+    }
+    c
+}
+
 fn batch(dir: &Path, args: &[&str]) -> std::process::Output {
-    let mut all = vec!["batch"];
-    all.extend_from_slice(args);
-    run(&all, dir)
+    lv().arg("batch")
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run latvox batch")
 }
 
 fn stderr(o: &std::process::Output) -> String {
@@ -161,7 +179,7 @@ fn a_killed_batch_resumes_without_running_a_finished_job_again() {
     )
     .unwrap();
     let total = 12;
-    let mut child = latvox()
+    let mut child = lv()
         .args(["batch", "jobs.toml", "--workers", "2", "-q"])
         .current_dir(d)
         .stdout(Stdio::null())
@@ -292,8 +310,7 @@ fn the_union_of_the_shards_is_the_whole_batch() {
     // Three shards at once, as a job array would run them: two by --shard, one by Slurm's
     // variables (an array 1-3, so task 2 is shard 2/3).
     let spawn = |args: &[&str], env: &[(&str, &str)]| {
-        latvox()
-            .arg("batch")
+        lv().arg("batch")
             .args(args)
             .args(["--threads", "1", "-q"])
             .envs(env.iter().copied())

@@ -376,3 +376,87 @@ fn suffixed(base: &Path, suffix: &str) -> PathBuf {
     s.push(suffix);
     PathBuf::from(s)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    fn job(text: &str) -> Job {
+        latvox::batch::jobfile::parse(text).unwrap().remove(0)
+    }
+
+    /// A subcommand shaped like `latvox repair IN -o OUT`: a positional input and a switch.
+    #[derive(clap::Parser)]
+    struct RepairLike {
+        input: PathBuf,
+        #[arg(long, short = 'o')]
+        output: PathBuf,
+        #[arg(long)]
+        fill_holes: bool,
+        #[arg(long)]
+        weld_tolerance: Option<f64>,
+    }
+
+    #[test]
+    fn tables_become_the_subcommands_command_line() {
+        let mut cmd = RepairLike::command().no_binary_name(true);
+        cmd.build();
+        let j = job(
+            "[[job]]\ncommand='repair'\noutput='fixed.stl'\ninput='broken.stl'\n\
+             fill_holes=true\nweld-tolerance=1e-5\n",
+        );
+        let argv = command_line(&cmd, &j).unwrap();
+        assert_eq!(
+            argv,
+            [
+                "--output=fixed.stl",
+                "--fill-holes",
+                "--weld-tolerance=0.00001",
+                "--",
+                "broken.stl"
+            ]
+        );
+        let m = cmd.try_get_matches_from_mut(argv).unwrap();
+        let a = RepairLike::from_arg_matches(&m).unwrap();
+        assert_eq!(a.input, Path::new("broken.stl"));
+        assert!(a.fill_holes);
+        assert_eq!(a.weld_tolerance, Some(1e-5));
+
+        let off =
+            job("[[job]]\ncommand='repair'\noutput='f.stl'\ninput='b.stl'\nfill-holes=false\n");
+        assert_eq!(
+            command_line(&cmd, &off).unwrap(),
+            ["--output=f.stl", "--", "b.stl"]
+        );
+    }
+
+    #[test]
+    fn tpms_jobs_parse_like_the_command_line() {
+        let j = job(
+            "[[job]]\ncommand='tpms'\noutput='a.stl'\ntype='d'\nstructure='sheet'\n\
+             density=0.25\ncells=[4,4,2]\ncell-size=6\norigin=[-5, 0, 2.5]\nascii=true\n",
+        );
+        let t = parse_job::<TpmsArgs>("tpms", &j).unwrap();
+        assert_eq!(t.outputs(), [PathBuf::from("a.stl")]);
+        let mut cmd = TpmsArgs::augment_args(clap::Command::new("tpms")).no_binary_name(true);
+        cmd.build();
+        let m = cmd
+            .try_get_matches_from_mut(command_line(&cmd, &j).unwrap())
+            .unwrap();
+        let a = TpmsArgs::from_arg_matches(&m).unwrap();
+        assert_eq!(a.cells, Some([4, 4, 2]));
+        assert_eq!(a.cell_size, Some([6.0; 3]));
+        assert_eq!(a.origin, [-5.0, 0.0, 2.5]);
+        assert_eq!(a.density, 0.25);
+        assert!(a.ascii);
+        assert!(!a.allow_islands);
+
+        let bad = job("[[job]]\ncommand='tpms'\noutput='a.stl'\ncell_sise=5\n");
+        let e = parse_job::<TpmsArgs>("tpms", &bad).err().unwrap();
+        assert!(
+            e.contains("'--cell-sise'") && e.contains("'--cell-size'"),
+            "{e}"
+        );
+    }
+}

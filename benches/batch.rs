@@ -1,0 +1,132 @@
+//! Batch benchmark, with the figures quoted in README: 40 small TPMS jobs (4 types × 5 densities
+//! × net and sheet, 2×2×2 cells of 5 mm, 16 voxels per cell, each with its JSON report) run
+//!
+//! 1. as 40 `latvox tpms` invocations in a shell loop (`bash loop.sh`), and
+//! 2. as one `latvox batch jobs.toml` (default workers: one per thread; and `--workers 1`),
+//!
+//! each in a fresh folder, wall time of the whole, median of several runs; the ratio is loop time
+//! over batch time within each run (the three cases of a run follow each other, so they share
+//! the machine's load), median over the runs. The parts of both are compared byte for byte.
+//!
+//! Run: `cargo bench --bench batch` (add `-- --runs N` to change the repeat count).
+
+use std::path::Path;
+use std::process::Command;
+use std::time::Instant;
+
+const TYPES: [&str; 4] = ["gyroid", "d", "p", "iwp"];
+const DENSITIES: [f64; 5] = [0.25, 0.3, 0.35, 0.4, 0.45];
+const STRUCTURES: [&str; 2] = ["net", "sheet"];
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+fn timed(cmd: &mut Command) -> f64 {
+    let start = Instant::now();
+    let out = cmd.output().expect("spawn");
+    let secs = start.elapsed().as_secs_f64();
+    assert!(
+        out.status.success(),
+        "{:?} failed: {}",
+        cmd,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    secs
+}
+
+fn fresh(dir: &Path) {
+    let _ = std::fs::remove_dir_all(dir);
+    std::fs::create_dir_all(dir.join("out")).unwrap();
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let runs = args
+        .iter()
+        .position(|a| a == "--runs")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3usize);
+    let exe = env!("CARGO_BIN_EXE_latvox");
+    let tmp = tempfile::tempdir().unwrap();
+    let threads = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+
+    let common = "cells = 2\ncell-size = 5\nresolution = 16\n";
+    let jobs = format!(
+        "[defaults]\n{common}\n[[sweep]]\ncommand = \"tpms\"\noutput = \"out/{{type}}-{{structure}}-{{density}}.stl\"\n\
+         type = {TYPES:?}\nstructure = {STRUCTURES:?}\ndensity = {DENSITIES:?}\n"
+    );
+    let mut script = String::from("set -e\n");
+    let mut names = Vec::new();
+    for t in TYPES {
+        for s in STRUCTURES {
+            for d in DENSITIES {
+                let name = format!("out/{t}-{s}-{d}");
+                script.push_str(&format!(
+                    "'{exe}' tpms --type {t} --structure {s} --density {d} --cells 2 --cell-size 5 \
+                     --resolution 16 -q -o {name}.stl --report {name}.json > /dev/null\n"
+                ));
+                names.push(name);
+            }
+        }
+    }
+    assert_eq!(names.len(), 40);
+
+    let (loop_dir, batch_dir) = (tmp.path().join("loop"), tmp.path().join("batch"));
+    let mut cases: Vec<(String, Vec<f64>)> = vec![
+        ("shell loop of 40 `latvox tpms`".into(), vec![]),
+        (
+            format!("`latvox batch`, {threads} workers (default)"),
+            vec![],
+        ),
+        ("`latvox batch --workers 1`".into(), vec![]),
+    ];
+    for _ in 0..runs {
+        fresh(&loop_dir);
+        std::fs::write(loop_dir.join("loop.sh"), &script).unwrap();
+        cases[0].1.push(timed(
+            Command::new("bash").arg("loop.sh").current_dir(&loop_dir),
+        ));
+        for (k, extra) in [(1, vec![]), (2, vec!["--workers", "1"])] {
+            fresh(&batch_dir);
+            std::fs::write(batch_dir.join("jobs.toml"), &jobs).unwrap();
+            cases[k].1.push(timed(
+                Command::new(exe)
+                    .args(["batch", "jobs.toml", "-q"])
+                    .args(&extra)
+                    .current_dir(&batch_dir),
+            ));
+        }
+    }
+    for n in &names {
+        let stl = format!("{n}.stl");
+        assert!(
+            std::fs::read(loop_dir.join(&stl)).unwrap()
+                == std::fs::read(batch_dir.join(&stl)).unwrap(),
+            "{stl} differs between the loop and the batch"
+        );
+    }
+
+    println!(
+        "machine: {threads} threads; 40 TPMS jobs (4 types x 2 structures x 5 densities, 2x2x2 cells, 16 voxels/cell, STL + JSON report each); {runs} runs, median wall time"
+    );
+    // The machine is shared: the three cases of a run follow each other closely, so the ratio
+    // is taken within each run and its median reported.
+    let loops = cases[0].1.clone();
+    for (label, times) in &cases {
+        let m = median(times.clone());
+        let ratio = median(loops.iter().zip(times).map(|(l, t)| l / t).collect());
+        println!(
+            "{label:<40} {m:7.2} s   loop/this = {ratio:.2}x   (runs: {})",
+            times
+                .iter()
+                .map(|t| format!("{t:.2}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+}
