@@ -36,6 +36,13 @@ fn timed(cmd: &mut Command) -> f64 {
     secs
 }
 
+/// The machine is shared: its load is part of the result.
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_default()
+}
+
 fn fresh(dir: &Path) {
     let _ = std::fs::remove_dir_all(dir);
     std::fs::create_dir_all(dir.join("out")).unwrap();
@@ -76,6 +83,10 @@ fn main() {
     }
     assert_eq!(names.len(), 40);
 
+    println!(
+        "load average (1, 5, 15 min) at the start: {}",
+        load_average()
+    );
     let (loop_dir, batch_dir) = (tmp.path().join("loop"), tmp.path().join("batch"));
     let mut cases: Vec<(String, Vec<f64>)> = vec![
         ("shell loop of 40 `latvox tpms`".into(), vec![]),
@@ -111,6 +122,7 @@ fn main() {
         );
     }
 
+    println!("load average (1, 5, 15 min) at the end: {}", load_average());
     println!(
         "machine: {threads} threads; 40 TPMS jobs (4 types x 2 structures x 5 densities, 2x2x2 cells, 16 voxels/cell, STL + JSON report each); {runs} runs, median wall time"
     );
