@@ -4,9 +4,11 @@
 //! 1. as 40 `latvox tpms` invocations in a shell loop (`bash loop.sh`), and
 //! 2. as one `latvox batch jobs.toml` (default workers: one per thread; and `--workers 1`),
 //!
-//! each in a fresh folder, wall time of the whole, median of several runs; the ratio is loop time
+//! each in a fresh folder, wall time and CPU time (user + system) of the whole, median of several
+//! runs; the ratio is loop time
 //! over batch time within each run (the three cases of a run follow each other, so they share
-//! the machine's load), median over the runs. The parts of both are compared byte for byte.
+//! the machine's load), median over the runs. The parts of both are compared (level and
+//! triangle count).
 //!
 //! Run: `cargo bench --bench batch` (add `-- --runs N` to change the repeat count).
 
@@ -23,17 +25,29 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn timed(cmd: &mut Command) -> f64 {
+/// User + system CPU seconds of all finished children (and theirs: the loop's latvox runs).
+fn children_cpu() -> f64 {
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: getrusage fills the struct it is given.
+    unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut u) };
+    let t = |v: libc::timeval| v.tv_sec as f64 + v.tv_usec as f64 * 1e-6;
+    t(u.ru_utime) + t(u.ru_stime)
+}
+
+/// Wall and CPU seconds of `cmd`, which must succeed.
+fn timed(cmd: &mut Command) -> (f64, f64) {
+    let cpu = children_cpu();
     let start = Instant::now();
     let out = cmd.output().expect("spawn");
     let secs = start.elapsed().as_secs_f64();
+    let cpu = children_cpu() - cpu;
     assert!(
         out.status.success(),
         "{:?} failed: {}",
         cmd,
         String::from_utf8_lossy(&out.stderr)
     );
-    secs
+    (secs, cpu)
 }
 
 /// The machine is shared: its load is part of the result.
@@ -88,40 +102,47 @@ fn main() {
         load_average()
     );
     let (loop_dir, batch_dir) = (tmp.path().join("loop"), tmp.path().join("batch"));
-    let mut cases: Vec<(String, Vec<f64>)> = vec![
-        ("shell loop of 40 `latvox tpms`".into(), vec![]),
+    // (label, wall times, CPU times)
+    let mut cases: Vec<(String, Vec<f64>, Vec<f64>)> = vec![
+        ("shell loop of 40 `latvox tpms`".into(), vec![], vec![]),
         (
             format!("`latvox batch`, {threads} workers (default)"),
             vec![],
+            vec![],
         ),
-        ("`latvox batch --workers 1`".into(), vec![]),
+        ("`latvox batch --workers 1`".into(), vec![], vec![]),
     ];
     for _ in 0..runs {
         fresh(&loop_dir);
         std::fs::write(loop_dir.join("loop.sh"), &script).unwrap();
-        cases[0].1.push(timed(
-            Command::new("bash").arg("loop.sh").current_dir(&loop_dir),
-        ));
+        let (wall, cpu) = timed(Command::new("bash").arg("loop.sh").current_dir(&loop_dir));
+        cases[0].1.push(wall);
+        cases[0].2.push(cpu);
         for (k, extra) in [(1, vec![]), (2, vec!["--workers", "1"])] {
             fresh(&batch_dir);
             std::fs::write(batch_dir.join("jobs.toml"), &jobs).unwrap();
-            cases[k].1.push(timed(
+            let (wall, cpu) = timed(
                 Command::new(exe)
                     .args(["batch", "jobs.toml", "-q"])
                     .args(&extra)
                     .current_dir(&batch_dir),
-            ));
+            );
+            cases[k].1.push(wall);
+            cases[k].2.push(cpu);
         }
     }
+    // Same parts: same level and triangle count in every report (the triangles themselves may
+    // differ in which diagonal cuts a quad, as thread scheduling goes).
     for n in &names {
-        let stl = format!("{n}.stl");
+        let report = |d: &Path| -> serde_json::Value {
+            serde_json::from_slice(&std::fs::read(d.join(format!("{n}.json"))).unwrap()).unwrap()
+        };
+        let (a, b) = (report(&loop_dir), report(&batch_dir));
         assert!(
-            std::fs::read(loop_dir.join(&stl)).unwrap()
-                == std::fs::read(batch_dir.join(&stl)).unwrap(),
-            "{stl} differs between the loop and the batch"
+            a["level"] == b["level"] && a["triangles"] == b["triangles"],
+            "{n}: the loop and the batch made different parts"
         );
     }
-
     println!("load average (1, 5, 15 min) at the end: {}", load_average());
     println!(
         "machine: {threads} threads; 40 TPMS jobs (4 types x 2 structures x 5 densities, 2x2x2 cells, 16 voxels/cell, STL + JSON report each); {runs} runs, median wall time"
@@ -129,11 +150,12 @@ fn main() {
     // The machine is shared: the three cases of a run follow each other closely, so the ratio
     // is taken within each run and its median reported.
     let loops = cases[0].1.clone();
-    for (label, times) in &cases {
+    for (label, times, cpu) in &cases {
         let m = median(times.clone());
         let ratio = median(loops.iter().zip(times).map(|(l, t)| l / t).collect());
         println!(
-            "{label:<40} {m:7.2} s   loop/this = {ratio:.2}x   (runs: {})",
+            "{label:<40} wall {m:6.2} s   loop/this = {ratio:.2}x   CPU {:6.2} s   (wall of each run: {})",
+            median(cpu.clone()),
             times
                 .iter()
                 .map(|t| format!("{t:.2}"))
