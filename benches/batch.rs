@@ -131,15 +131,16 @@ fn main() {
             cases[k].2.push(cpu);
         }
     }
-    // Same parts: same level and triangle count in every report (the triangles themselves may
-    // differ in which diagonal cuts a quad, as thread scheduling goes).
+    // Same parts: same level (to its last bits, which vary with the order of parallel sums) and
+    // triangle count in every report.
     for n in &names {
         let report = |d: &Path| -> serde_json::Value {
             serde_json::from_slice(&std::fs::read(d.join(format!("{n}.json"))).unwrap()).unwrap()
         };
         let (a, b) = (report(&loop_dir), report(&batch_dir));
+        let level = |r: &serde_json::Value| r["level"].as_f64().unwrap();
         assert!(
-            a["level"] == b["level"] && a["triangles"] == b["triangles"],
+            (level(&a) - level(&b)).abs() < 1e-9 && a["triangles"] == b["triangles"],
             "{n}: the loop and the batch made different parts"
         );
     }

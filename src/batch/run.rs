@@ -266,3 +266,95 @@ impl Context<'_> {
 pub(crate) fn rfc3339(t: SystemTime) -> String {
     humantime::format_rfc3339_millis(t).to_string()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::batch::jobfile::parse;
+
+    /// Writes `text` to its output, then reports `passed`, or panics, or writes nothing.
+    struct Fake {
+        output: PathBuf,
+        behaviour: &'static str,
+    }
+
+    impl Task for Fake {
+        fn outputs(&self) -> Vec<PathBuf> {
+            vec![self.output.clone()]
+        }
+        fn run(&self) -> Result<TaskReport> {
+            match self.behaviour {
+                "panic" => panic!("fake failure"),
+                "nothing" => {}
+                _ => crate::output::write_atomic(&self.output, |w| w.write_all(b"part"))?,
+            }
+            Ok(TaskReport {
+                report: serde_json::json!({ "kind": "fake" }),
+                passed: self.behaviour != "defects",
+                warnings: vec!["w".into()],
+            })
+        }
+    }
+
+    #[test]
+    fn outcomes_are_recorded_and_only_good_jobs_are_skipped_later() {
+        let dir = tempfile::tempdir().unwrap();
+        let behaviours = ["ok", "defects", "panic", "nothing"];
+        let text: String = behaviours
+            .iter()
+            .map(|b| format!("[[job]]\ncommand = 'fake'\noutput = '{b}.part'\n"))
+            .collect();
+        let file = JobFile {
+            path: dir.path().join("jobs.toml"),
+            dir: dir.path().to_path_buf(),
+            jobs: parse(&text).unwrap(),
+        };
+        let fakes: Vec<Fake> = behaviours
+            .iter()
+            .map(|b| Fake {
+                output: dir.path().join(format!("{b}.part")),
+                behaviour: b,
+            })
+            .collect();
+        let tasks: Vec<&dyn Task> = fakes.iter().map(|f| f as &dyn Task).collect();
+        let settings = Settings {
+            workers: 3,
+            shard: None,
+            force: false,
+        };
+        let s = run(&file, &tasks, settings, &mut |_| {}).unwrap();
+        let status: Vec<Status> = s.jobs.iter().map(|r| r.status).collect();
+        assert_eq!(
+            status,
+            [Status::Ok, Status::Defects, Status::Failed, Status::Failed]
+        );
+        assert_eq!(s.jobs[0].warnings, 1);
+        assert!(s.jobs[2]
+            .error
+            .as_deref()
+            .unwrap()
+            .contains("panic: fake failure"));
+        assert!(s.jobs[3].error.as_deref().unwrap().contains("nothing.part"));
+        assert!(!s.all_done());
+        let report: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("defects.json")).unwrap())
+                .unwrap();
+        assert_eq!(report["kind"], "fake");
+        assert_eq!(report["batch"]["outcome"], "defects");
+        assert_eq!(report["batch"]["outputs"][0]["bytes"], 4);
+        assert!(!dir.path().join("panic.json").exists());
+
+        let again = run(&file, &tasks, settings, &mut |_| {}).unwrap();
+        let status: Vec<Status> = again.jobs.iter().map(|r| r.status).collect();
+        assert_eq!(
+            status,
+            [
+                Status::Skipped,
+                Status::Defects,
+                Status::Failed,
+                Status::Failed
+            ]
+        );
+        assert_eq!(again.jobs[0].run_id, s.jobs[0].run_id);
+    }
+}
