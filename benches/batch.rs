@@ -1,14 +1,14 @@
 //! Batch benchmark, with the figures quoted in README: 40 small TPMS jobs (4 types × 5 densities
-//! × net and sheet, 2×2×2 cells of 5 mm, 16 voxels per cell, each with its JSON report) run
+//! × net and sheet, 2×2×2 cells of 5 mm, then 1 cell, 16 voxels per cell, each with its JSON
+//! report) run
 //!
 //! 1. as 40 `latvox tpms` invocations in a shell loop (`bash loop.sh`), and
 //! 2. as one `latvox batch jobs.toml` (default workers: one per thread; and `--workers 1`),
 //!
 //! each in a fresh folder, wall time and CPU time (user + system) of the whole, median of several
-//! runs; the ratio is loop time
-//! over batch time within each run (the three cases of a run follow each other, so they share
-//! the machine's load), median over the runs. The parts of both are compared (level and
-//! triangle count).
+//! runs; the ratio is loop time over batch time within each run (the three cases of a run follow
+//! each other, so they share the machine's load), median over the runs. The parts of both are
+//! compared (level and triangle count).
 //!
 //! Run: `cargo bench --bench batch` (add `-- --runs N` to change the repeat count).
 
@@ -70,13 +70,24 @@ fn main() {
         .and_then(|i| args.get(i + 1))
         .and_then(|s| s.parse().ok())
         .unwrap_or(3usize);
-    let exe = env!("CARGO_BIN_EXE_latvox");
     let tmp = tempfile::tempdir().unwrap();
+    println!(
+        "load average (1, 5, 15 min) at the start: {}",
+        load_average()
+    );
+    for cells in [2, 1] {
+        measure(tmp.path(), cells, runs);
+    }
+    println!("load average (1, 5, 15 min) at the end: {}", load_average());
+}
+
+/// The 40 jobs with `cells`³ cells each, as a loop and as a batch, `runs` times.
+fn measure(tmp: &Path, cells: u32, runs: usize) {
+    let exe = env!("CARGO_BIN_EXE_latvox");
     let threads = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1);
-
-    let common = "cells = 2\ncell-size = 5\nresolution = 16\n";
+    let common = format!("cells = {cells}\ncell-size = 5\nresolution = 16\n");
     let jobs = format!(
         "[defaults]\n{common}\n[[sweep]]\ncommand = \"tpms\"\noutput = \"out/{{type}}-{{structure}}-{{density}}.stl\"\n\
          type = {TYPES:?}\nstructure = {STRUCTURES:?}\ndensity = {DENSITIES:?}\n"
@@ -88,7 +99,7 @@ fn main() {
             for d in DENSITIES {
                 let name = format!("out/{t}-{s}-{d}");
                 script.push_str(&format!(
-                    "'{exe}' tpms --type {t} --structure {s} --density {d} --cells 2 --cell-size 5 \
+                    "'{exe}' tpms --type {t} --structure {s} --density {d} --cells {cells} --cell-size 5 \
                      --resolution 16 -q -o {name}.stl --report {name}.json > /dev/null\n"
                 ));
                 names.push(name);
@@ -97,11 +108,7 @@ fn main() {
     }
     assert_eq!(names.len(), 40);
 
-    println!(
-        "load average (1, 5, 15 min) at the start: {}",
-        load_average()
-    );
-    let (loop_dir, batch_dir) = (tmp.path().join("loop"), tmp.path().join("batch"));
+    let (loop_dir, batch_dir) = (tmp.join("loop"), tmp.join("batch"));
     // (label, wall times, CPU times)
     let mut cases: Vec<(String, Vec<f64>, Vec<f64>)> = vec![
         ("shell loop of 40 `latvox tpms`".into(), vec![], vec![]),
@@ -144,9 +151,8 @@ fn main() {
             "{n}: the loop and the batch made different parts"
         );
     }
-    println!("load average (1, 5, 15 min) at the end: {}", load_average());
     println!(
-        "machine: {threads} threads; 40 TPMS jobs (4 types x 2 structures x 5 densities, 2x2x2 cells, 16 voxels/cell, STL + JSON report each); {runs} runs, median wall time"
+        "machine: {threads} threads; 40 TPMS jobs (4 types x 2 structures x 5 densities, {cells}x{cells}x{cells} cells, 16 voxels/cell, STL + JSON report each); {runs} runs, median wall time"
     );
     // The machine is shared: the three cases of a run follow each other closely, so the ratio
     // is taken within each run and its median reported.
