@@ -13,6 +13,8 @@ PKGS=(
   # libraries the PyPI gmsh wheel (OpenCASCADE, reads IGES back) links against
   python3 python3-pip python3-venv libglu1-mesa libgl1 libopengl0 libxrender1 libxcursor1
   libxfixes3 libxext6 libxft2 libfontconfig1 libxinerama1 libx11-6 libgomp1
+  # tests: a one-node Slurm cluster for latvox batch (scripts/slurm-test.sh)
+  slurm-wlm munge
 )
 
 if [ "$(id -u)" -eq 0 ]; then SUDO=(); else SUDO=(sudo); fi

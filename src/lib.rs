@@ -4,8 +4,10 @@
 //!
 //! Stages, one module each: [`field`] → [`grid`] → [`mesh`] → [`verify`] → [`stl`] (output).
 //! Capabilities: [`tpms`], [`topopt`] (SIMP optimiser), [`topo`] (density fields to STL and CAD),
-//! [`cad`] (B-spline curves, IGES, DXF).
+//! [`cad`] (B-spline curves, IGES, DXF), [`batch`] (many jobs, resumable, sharded over Slurm
+//! arrays).
 
+pub mod batch;
 pub mod cad;
 pub mod error;
 pub mod extract;

@@ -38,6 +38,9 @@ enum Command {
     /// Density field to printable STL and parametric CAD (IGES, DXF): seed 003's pipeline.
     #[command(after_help = cli::topo::EXAMPLES)]
     Topo(cli::topo::TopoArgs),
+    /// Run many jobs from a TOML job file: sweeps, workers, resume after a kill, Slurm arrays.
+    #[command(after_help = cli::batch::EXAMPLES)]
+    Batch(cli::batch::BatchArgs),
 }
 
 fn main() {
@@ -83,6 +86,7 @@ fn main() {
         Command::Check(a) => cli::check::run(a),
         Command::Topopt(a) => cli::topopt::run(a, cli.quiet),
         Command::Topo(a) => cli::topo::run(a, cli.quiet),
+        Command::Batch(a) => cli::batch::run(a, cli.quiet),
     };
     match result {
         Ok(code) => std::process::exit(code),

@@ -1,5 +1,9 @@
 //! Atomic output: write to a temporary file in the destination folder, then rename over the
 //! target. A run that fails midway leaves no file behind, and never a half-written one.
+//!
+//! The temporary is named after its target (`.NAME.latvox-XXXXXX`), so when a process is killed
+//! outright (SIGKILL: no destructor runs) the leftover can be recognised and removed by whoever
+//! next writes that target ([`remove_stale_temporaries`]), e.g. a resumed batch.
 
 use crate::error::{Error, Result};
 use std::io::{BufWriter, Write};
@@ -45,13 +49,61 @@ fn parent_dir(path: &Path) -> &Path {
 }
 
 /// A new temporary file in `path`'s folder, with ordinary permissions, to be renamed over
-/// `path` once complete (it is deleted if dropped instead).
+/// `path` once complete (it is deleted if dropped instead; a killed run's is found by
+/// [`remove_stale_temporaries`]).
 pub fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile> {
     tempfile::Builder::new()
-        .prefix(".latvox-")
+        .prefix(&temp_prefix(path))
+        .rand_bytes(RANDOM_LEN)
         .permissions(file_mode())
         .tempfile_in(parent_dir(path))
         .map_err(|e| Error::io(path, e))
+}
+
+/// Length of the random part of a temporary's name (tempfile's default).
+const RANDOM_LEN: usize = 6;
+
+/// `.NAME.latvox-`: the start of every temporary written for `path` (the name is cut short so
+/// that the temporary's own name stays within the usual 255-byte limit).
+fn temp_prefix(path: &Path) -> String {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut end = name.len().min(200);
+    while !name.is_char_boundary(end) {
+        end -= 1;
+    }
+    format!(".{}.latvox-", &name[..end])
+}
+
+/// Removes temporaries left by writes of `path` that never finished (their process was killed).
+/// Only call this when no other process can be writing `path` at the same moment; returns how
+/// many were removed.
+pub fn remove_stale_temporaries(path: &Path) -> Result<usize> {
+    let dir = parent_dir(path);
+    let prefix = temp_prefix(path);
+    let entries = match std::fs::read_dir(dir) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(0),
+        Err(e) => return Err(Error::io(dir, e)),
+    };
+    let mut removed = 0;
+    for entry in entries {
+        let entry = entry.map_err(|e| Error::io(dir, e))?;
+        let name = entry.file_name();
+        let Some(rest) = name.to_str().and_then(|n| n.strip_prefix(&prefix)) else {
+            continue;
+        };
+        if rest.len() == RANDOM_LEN && rest.bytes().all(|b| b.is_ascii_alphanumeric()) {
+            match std::fs::remove_file(entry.path()) {
+                Ok(()) => removed += 1,
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(e) => return Err(Error::io(entry.path(), e)),
+            }
+        }
+    }
+    Ok(removed)
 }
 
 /// Writes `path` atomically through `body`.
@@ -65,6 +117,17 @@ pub fn write_atomic(
         body(&mut w).map_err(|e| Error::io(path, e))?;
         w.flush().map_err(|e| Error::io(path, e))?;
     }
+    // On disk before the rename: after a crash of the machine, not only of the process, the
+    // name holds the old file or the whole new one, never a new file with lost blocks.
+    tmp.as_file().sync_data().map_err(|e| Error::io(path, e))?;
     tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
     Ok(())
+}
+
+/// Writes `value` as pretty-printed JSON to `path`, atomically.
+pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
+    write_atomic(path, |w| {
+        serde_json::to_writer_pretty(&mut *w, value).map_err(std::io::Error::other)?;
+        w.write_all(b"\n")
+    })
 }

@@ -1,5 +1,6 @@
 //! Progress on long steps: a spinner on stderr for any stage that lasts over a second, only when
 //! stderr is a terminal and the user did not ask for quiet. Pipes and logs stay clean.
+//! Work made of many items (the jobs of a batch) gets a counting bar instead.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -52,6 +53,61 @@ impl Progress {
         Stage {
             done: Some(tx),
             thread: Some(thread),
+        }
+    }
+}
+
+impl Progress {
+    /// A bar counting `len` items of `what` (e.g. "jobs"), drawn on stderr when enabled.
+    pub fn counter(&self, len: u64, what: &str) -> Counter {
+        if !self.enabled || len == 0 {
+            return Counter { bar: None };
+        }
+        let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template(&format!(
+                "{{bar:30}} {{pos}}/{{len}} {what} · {{elapsed}} (about {{eta}} left) {{msg}}"
+            ))
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        bar.enable_steady_tick(Duration::from_millis(200));
+        Counter { bar: Some(bar) }
+    }
+}
+
+/// A counting bar, or nothing; cleared when dropped.
+pub struct Counter {
+    bar: Option<ProgressBar>,
+}
+
+impl Counter {
+    /// One more item done.
+    pub fn inc(&self) {
+        if let Some(b) = &self.bar {
+            b.inc(1);
+        }
+    }
+
+    /// A short note after the count (e.g. "2 failed").
+    pub fn note(&self, msg: String) {
+        if let Some(b) = &self.bar {
+            b.set_message(msg);
+        }
+    }
+
+    /// Prints a line on stdout without tearing the bar.
+    pub fn println(&self, line: &str) {
+        match &self.bar {
+            Some(b) => b.suspend(|| println!("{line}")),
+            None => println!("{line}"),
+        }
+    }
+}
+
+impl Drop for Counter {
+    fn drop(&mut self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
         }
     }
 }

@@ -1,6 +1,7 @@
 //! Pieces shared by the subcommands: option parsers, JSON output, summary formatting.
 //! Each subcommand lives in its own file and exposes `Args` (clap) and `run`.
 
+pub mod batch;
 pub mod check;
 pub mod topo;
 pub mod topopt;
@@ -78,10 +79,7 @@ pub(crate) fn parse_unit(s: &str) -> std::result::Result<f64, String> {
 }
 
 pub(crate) fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
-    latvox::output::write_atomic(path, |w| {
-        serde_json::to_writer_pretty(&mut *w, value).map_err(std::io::Error::other)?;
-        w.write_all(b"\n")
-    })
+    latvox::output::write_json(path, value)
 }
 
 pub(crate) fn yes(b: bool) -> &'static str {

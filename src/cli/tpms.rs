@@ -5,7 +5,7 @@ use super::{
 };
 use clap::Args;
 use latvox::stl::StlFormat;
-use latvox::tpms::{Domain, Structure, Surface, TpmsJob};
+use latvox::tpms::{Domain, Structure, Surface, TpmsJob, TpmsReport};
 use latvox::{Error, Result};
 use std::path::PathBuf;
 
@@ -115,6 +115,24 @@ fn domain(a: &TpmsArgs) -> Result<Domain> {
 }
 
 pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
+    // Fail on an unwritable destination before the work, not after.
+    if let Some(r) = &a.report {
+        latvox::output::check_writable(r)?;
+    }
+    let report = execute(a, &latvox::progress::Progress::new(quiet))?;
+    if let Some(r) = &a.report {
+        write_json(r, &report)?;
+    }
+    for w in &report.warnings {
+        eprintln!("latvox: warning: {w}");
+    }
+    print_tpms_summary(&report);
+    Ok(if passed(&report) { 0 } else { 1 })
+}
+
+/// Runs the job and writes its STL atomically; returns the report (output and write time
+/// filled in), for `run` to print and `latvox batch` to record.
+pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<TpmsReport> {
     let job = TpmsJob {
         surface: a.surface,
         structure: a.structure,
@@ -127,12 +145,7 @@ pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
         self_intersection: !a.no_self_intersection_check,
         instancing: !a.no_instancing,
     };
-    // Fail on an unwritable destination before the work, not after.
     latvox::output::check_writable(&a.output)?;
-    if let Some(r) = &a.report {
-        latvox::output::check_writable(r)?;
-    }
-    let progress = latvox::progress::Progress::new(quiet);
     let format = if a.ascii {
         StlFormat::Ascii
     } else {
@@ -140,27 +153,16 @@ pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
     };
     // The part streams into a temporary file that becomes the output only once the job is done.
     let mut sink = latvox::sink::StlSink::create(&a.output, format)?;
-    let mut report = job.run_into(&progress, &mut sink)?;
+    let mut report = job.run_into(progress, &mut sink)?;
     sink.commit()?;
     report.output = Some(a.output.display().to_string());
-    if let Some(r) = &a.report {
-        write_json(r, &report)?;
-    }
-    for w in &report.warnings {
-        eprintln!("latvox: warning: {w}");
-    }
-    print_tpms_summary(&report);
-    Ok(
-        if report.checks.is_valid_solid()
-            || !report.checks.self_intersection_checked
-                && report.checks.closed
-                && report.checks.outward
-        {
-            0
-        } else {
-            1
-        },
-    )
+    Ok(report)
+}
+
+/// Whether the part passed CGAL's checks (those that were asked for).
+pub fn passed(r: &TpmsReport) -> bool {
+    r.checks.is_valid_solid()
+        || !r.checks.self_intersection_checked && r.checks.closed && r.checks.outward
 }
 
 fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
