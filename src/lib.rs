@@ -2,18 +2,19 @@
 //! printable, verified meshes. Rust samples fields and orchestrates; OpenVDB holds the sparse
 //! level sets and meshes them; CGAL verifies the result.
 //!
-//! Stages, one module each: [`field`] → [`grid`] → [`mesh`] → [`verify`] → [`stl`] (output).
+//! Stages, one module each: [`field`] → [`grid`] → [`mesh`] → [`verify`] → [`io`] (files).
 //! Capabilities: [`tpms`].
 
 pub mod error;
 pub(crate) mod ffi;
 pub mod field;
 pub mod grid;
+pub mod io;
 pub mod mesh;
 pub mod output;
 pub mod progress;
 pub mod snap;
-pub mod stl;
+pub mod triangulate;
 pub mod tpms;
 pub mod verify;
 

@@ -23,7 +23,7 @@ pub struct CheckArgs {
 }
 
 pub fn run(a: &CheckArgs) -> Result<i32> {
-    let mesh = latvox::stl::read(&a.file)?;
+    let mesh = latvox::io::stl::read(&a.file)?;
     let edges = mesh.edge_stats();
     let checks = latvox::verify::verify(&mesh, true)?;
     let ok = checks.is_valid_solid() && edges.boundary == 0 && edges.non_manifold == 0;

@@ -4,7 +4,7 @@ use super::{
     parse_counts, parse_density, parse_finite3, parse_positive3, parse_unit, write_json, yes,
 };
 use clap::Args;
-use latvox::stl::StlFormat;
+use latvox::io::stl::StlFormat;
 use latvox::tpms::{Domain, Structure, Surface, TpmsJob};
 use latvox::{Error, Result};
 use std::path::PathBuf;
@@ -137,7 +137,7 @@ pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
         } else {
             StlFormat::Binary
         };
-        latvox::stl::save(&mesh, format, &a.output)?;
+        latvox::io::stl::save(&mesh, format, &a.output)?;
     }
     report.timings.write = t.elapsed().as_secs_f64();
     report.timings.total += report.timings.write;
