@@ -3,8 +3,9 @@
 //! level sets and meshes them; CGAL verifies the result.
 //!
 //! Stages, one module each: [`field`] → [`grid`] → [`mesh`] → [`verify`] → [`io`] (files).
-//! Capabilities: [`tpms`].
+//! Capabilities: [`tpms`], [`check`] and [`repair`] (any mesh file, seed 001's defects).
 
+pub mod check;
 pub mod error;
 pub(crate) mod ffi;
 pub mod field;
@@ -13,8 +14,10 @@ pub mod io;
 pub mod mesh;
 pub mod output;
 pub mod progress;
+pub mod repair;
 pub mod snap;
 pub mod triangulate;
+pub mod topology;
 pub mod tpms;
 pub mod verify;
 

@@ -122,28 +122,16 @@ pub fn weld_indexed(positions: &[f32], indices: &[u32]) -> Result<Mesh, String> 
     Ok(mesh)
 }
 
-/// Merges vertices closer than `tol` mm (see the module notes); returns how many vertices were
-/// merged away. Unreferenced positions are dropped from the result.
-pub fn weld_tolerance(mesh: &mut Mesh, tol: f64) -> u64 {
-    if !(tol > 0.0) {
-        return 0;
-    }
-    let nv = mesh.vertex_count();
+/// Greedy clustering of `points` (see the module notes): the representative (an index into
+/// `points`) of each point. Points are taken in order; each joins the nearest earlier
+/// representative within `tol`, or becomes one.
+pub fn cluster(points: &[[f64; 3]], tol: f64) -> Vec<usize> {
     let cell = |p: [f64; 3]| p.map(|x| (x / tol).floor() as i64);
-    let mut grid: FastMap<[i64; 3], Vec<u32>> = HashMap::with_hasher(FastHash);
-    let mut rep_of = vec![u32::MAX; nv];
-    let mut new_pos: Vec<f32> = Vec::with_capacity(mesh.positions.len());
-    let mut used = vec![false; nv];
-    for &i in &mesh.indices {
-        used[i as usize] = true;
-    }
-    for v in 0..nv {
-        if !used[v] {
-            continue;
-        }
-        let p = mesh.vertex(v as u32);
+    let mut grid: FastMap<[i64; 3], Vec<usize>> = HashMap::with_hasher(FastHash);
+    let mut rep = Vec::with_capacity(points.len());
+    for (i, &p) in points.iter().enumerate() {
         let c = cell(p);
-        let mut best: Option<(f64, u32)> = None;
+        let mut best: Option<(f64, usize)> = None;
         for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
@@ -151,7 +139,7 @@ pub fn weld_tolerance(mesh: &mut Mesh, tol: f64) -> u64 {
                         continue;
                     };
                     for &r in list {
-                        let q = [0, 1, 2].map(|a| new_pos[3 * r as usize + a] as f64);
+                        let q = points[r];
                         let d2 = (0..3).map(|a| (p[a] - q[a]).powi(2)).sum::<f64>();
                         if d2 <= tol * tol && best.is_none_or(|(b, _)| d2 < b) {
                             best = Some((d2, r));
@@ -160,22 +148,47 @@ pub fn weld_tolerance(mesh: &mut Mesh, tol: f64) -> u64 {
                 }
             }
         }
-        rep_of[v] = match best {
+        rep.push(match best {
             Some((_, r)) => r,
             None => {
-                let r = (new_pos.len() / 3) as u32;
-                new_pos.extend_from_slice(&mesh.positions[3 * v..3 * v + 3]);
-                grid.entry(c).or_default().push(r);
-                r
+                grid.entry(c).or_default().push(i);
+                i
             }
-        };
+        });
     }
-    let used_count = used.iter().filter(|u| **u).count();
-    let merged = (used_count - new_pos.len() / 3) as u64;
+    rep
+}
+
+/// Merges vertices closer than `tol` mm (see the module notes); returns how many vertices were
+/// merged away. Unreferenced positions are dropped from the result.
+pub fn weld_tolerance(mesh: &mut Mesh, tol: f64) -> u64 {
+    if !(tol > 0.0) {
+        return 0;
+    }
+    let nv = mesh.vertex_count();
+    let mut used = vec![false; nv];
+    for &i in &mesh.indices {
+        used[i as usize] = true;
+    }
+    let ids: Vec<u32> = (0..nv as u32).filter(|&v| used[v as usize]).collect();
+    let pts: Vec<[f64; 3]> = ids.iter().map(|&v| mesh.vertex(v)).collect();
+    let rep = cluster(&pts, tol);
+    let mut new_id = vec![u32::MAX; nv];
+    let mut positions = Vec::new();
+    for (k, &v) in ids.iter().enumerate() {
+        if rep[k] == k {
+            new_id[v as usize] = (positions.len() / 3) as u32;
+            positions.extend_from_slice(&mesh.positions[3 * v as usize..3 * v as usize + 3]);
+        }
+    }
+    for (k, &v) in ids.iter().enumerate() {
+        new_id[v as usize] = new_id[ids[rep[k]] as usize];
+    }
     for i in mesh.indices.iter_mut() {
-        *i = rep_of[*i as usize];
+        *i = new_id[*i as usize];
     }
-    mesh.positions = new_pos;
+    let merged = (ids.len() - positions.len() / 3) as u64;
+    mesh.positions = positions;
     merged
 }
 
