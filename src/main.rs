@@ -29,9 +29,13 @@ enum Command {
     /// Generate a closed TPMS lattice at an exact volume fraction.
     #[command(after_help = cli::tpms::EXAMPLES)]
     Tpms(cli::tpms::TpmsArgs),
-    /// Check an STL with CGAL: closed, outward, self-intersections, volume, area.
+    /// Check a mesh file: every defect counted (holes, non-manifold, winding, normals, degenerate
+    /// and duplicate facets, T-junctions, self-intersections), per shell too.
     #[command(after_help = cli::check::EXAMPLES)]
     Check(cli::check::CheckArgs),
+    /// Repair a mesh file and report every change by kind and count.
+    #[command(after_help = cli::repair::EXAMPLES)]
+    Repair(cli::repair::RepairArgs),
 }
 
 fn main() {
@@ -74,7 +78,8 @@ fn main() {
     }
     let result = match &cli.command {
         Command::Tpms(a) => cli::tpms::run(a, cli.quiet),
-        Command::Check(a) => cli::check::run(a),
+        Command::Check(a) => cli::check::run(a, cli.quiet),
+        Command::Repair(a) => cli::repair::run(a, cli.quiet),
     };
     match result {
         Ok(code) => std::process::exit(code),

@@ -2,6 +2,7 @@
 //! Each subcommand lives in its own file and exposes `Args` (clap) and `run`.
 
 pub mod check;
+pub mod repair;
 pub mod tpms;
 
 use latvox::Result;
@@ -27,6 +28,24 @@ pub(crate) fn split3<T: Copy>(
 pub(crate) fn parse_f64(s: &str) -> std::result::Result<f64, String> {
     s.parse::<f64>()
         .map_err(|_| format!("'{s}' is not a number"))
+}
+
+pub(crate) fn parse_positive(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v > 0.0 && v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{s} must be a positive length in mm"))
+    }
+}
+
+pub(crate) fn parse_length0(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v >= 0.0 && v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{s} must be a length ≥ 0 mm"))
+    }
 }
 
 pub(crate) fn parse_positive3(s: &str) -> std::result::Result<[f64; 3], String> {

@@ -46,6 +46,39 @@ fn is_planar(pts: &[Vec3]) -> bool {
     pts.iter().all(|p| dot(sub(*p, c), n).abs() <= tol)
 }
 
+/// Whether all vertices of the facets `members` lie in one plane (that of the largest facet).
+pub fn is_flat(mesh: &Mesh, members: &[u32]) -> bool {
+    let Some(&big) = members.iter().max_by(|&&a, &&b| {
+        let area = |f: u32| {
+            let [p, q, r] = mesh.triangle(f as usize);
+            norm(crate::mesh::cross(sub(q, p), sub(r, p)))
+        };
+        area(a).total_cmp(&area(b))
+    }) else {
+        return false;
+    };
+    let [p, q, r] = mesh.triangle(big as usize);
+    let n = crate::mesh::cross(sub(q, p), sub(r, p));
+    let ln = norm(n);
+    if ln == 0.0 {
+        return false;
+    }
+    let pts: Vec<Vec3> = members
+        .iter()
+        .flat_map(|&f| mesh.triangle(f as usize))
+        .collect();
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for x in &pts {
+        for a in 0..3 {
+            lo[a] = lo[a].min(x[a]);
+            hi[a] = hi[a].max(x[a]);
+        }
+    }
+    let tol = PLANAR_REL * norm(sub(hi, lo));
+    pts.iter().all(|x| (dot(sub(*x, p), n) / ln).abs() <= tol)
+}
+
 /// Fills the closed `loops` of `mesh` (an oriented 2-manifold apart from its holes).
 /// `fair` selects CGAL's fairing for curved holes (otherwise triangulate and refine only).
 pub fn fill(mesh: &mut Mesh, loops: &[BoundaryLoop], fair: bool) -> Result<HoleStats> {

@@ -219,8 +219,26 @@ pub fn repair(mesh: &Mesh, opts: &RepairOptions, progress: &Progress) -> Result<
     let mut holes_left = 0;
     if opts.fill_holes {
         let _s = progress.stage("filling holes");
+        let nf = w.mesh.triangle_count();
         let (mesh, topo) = w.parts();
-        let loops = topo.boundary_loops(mesh);
+        let mut loops = topo.boundary_loops(mesh);
+        if !loops.is_empty() {
+            // A flat open sheet has no inside: filling its outline would only lay a second
+            // sheet on it. Such shells stay open (and are reported).
+            let (shell_of, n) = topo.shells(nf);
+            let members = check::shell_members(&shell_of, n);
+            let mut shell_of_vertex = vec![u32::MAX; mesh.vertex_count()];
+            for (f, &s) in shell_of.iter().enumerate() {
+                for k in 0..3 {
+                    shell_of_vertex[mesh.indices[3 * f + k] as usize] = s;
+                }
+            }
+            let flat: Vec<bool> = members.iter().map(|m| holes::is_flat(mesh, m)).collect();
+            loops.retain(|l| {
+                let s = shell_of_vertex[l.vertices[0] as usize];
+                s == u32::MAX || !flat[s as usize]
+            });
+        }
         if !loops.is_empty() {
             let st = holes::fill(&mut w.mesh, &loops, opts.fair)?;
             w.topo = None;

@@ -1,6 +1,7 @@
 //! Splitting steps of repair: edges cut at T-junction vertices (so neighbours share whole
 //! edges), and vertices duplicated where shells or sheets touch only at a vertex or along a
-//! non-manifold edge (so each shell is its own 2-manifold).
+//! non-manifold edge (so each shell is its own 2-manifold), then moved apart by a few
+//! micrometres so the separation survives formats that weld by position.
 
 use crate::check::TJunction;
 use crate::mesh::{cross, dot, norm, sub, Mesh};
@@ -87,7 +88,7 @@ pub fn split_non_manifold(mesh: &mut Mesh, topo: &Topology) -> (u64, u64) {
     let nv = mesh.vertex_count();
     let mut fan_vertex: std::collections::HashMap<u32, u32> = Default::default();
     let mut first_root = vec![u32::MAX; nv];
-    let mut copies = 0u64;
+    let mut split_vertices = Vec::new();
     for f in 0..mesh.triangle_count() {
         if !topo.active[f] {
             continue;
@@ -103,16 +104,69 @@ pub fn split_non_manifold(mesh: &mut Mesh, topo: &Topology) -> (u64, u64) {
                 continue;
             }
             let id = *fan_vertex.entry(r).or_insert_with(|| {
-                copies += 1;
                 let id = (mesh.positions.len() / 3) as u32;
                 let p = mesh.positions[3 * v as usize..3 * v as usize + 3].to_vec();
                 mesh.positions.extend_from_slice(&p);
+                split_vertices.push(v);
                 id
             });
             mesh.indices[c as usize] = id;
         }
     }
+    let copies = split_vertices.len() as u64;
+    if copies > 0 {
+        split_vertices.sort_unstable();
+        split_vertices.dedup();
+        separate(mesh, &split_vertices, nv);
+    }
     (nm_edges, copies)
+}
+
+/// Moves every copy of a split vertex a hair's breadth into its own fan (towards the centroid of
+/// its neighbours), so that the shells no longer touch: a file format without vertex indices
+/// (STL) would otherwise weld the copies back together. The move is 10⁻⁵ of the part's
+/// diagonal (a few micrometres on a desktop part), at most 1 % of the shortest incident edge.
+fn separate(mesh: &mut Mesh, split: &[u32], first_copy: usize) {
+    let diag = mesh
+        .bounds()
+        .map(|b| norm(sub(b.max, b.min)))
+        .unwrap_or(0.0);
+    let step = 1e-5 * diag;
+    let mut moved: std::collections::HashMap<u32, ([f64; 3], u32, f64)> = Default::default();
+    let is_split: std::collections::HashSet<u32> = split.iter().copied().collect();
+    for t in mesh.indices.chunks_exact(3) {
+        for k in 0..3 {
+            let v = t[k];
+            if (v as usize) < first_copy && !is_split.contains(&v) {
+                continue;
+            }
+            let p = mesh.vertex(v);
+            let e = moved.entry(v).or_insert(([0.0; 3], 0, f64::INFINITY));
+            for j in [t[(k + 1) % 3], t[(k + 2) % 3]] {
+                let q = mesh.vertex(j);
+                for a in 0..3 {
+                    e.0[a] += q[a];
+                }
+                e.1 += 1;
+                e.2 = e.2.min(norm(sub(q, p)));
+            }
+        }
+    }
+    for (v, (sum, n, shortest)) in moved {
+        let p = mesh.vertex(v);
+        let c = sum.map(|x| x / n as f64);
+        let d = sub(c, p);
+        let l = norm(d);
+        if l == 0.0 {
+            continue;
+        }
+        // At least a few units in the last place, or the move would vanish in single precision.
+        let ulp = 8.0 * f32::EPSILON as f64 * p.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let s = step.min(0.01 * shortest).max(ulp) / l;
+        for a in 0..3 {
+            mesh.positions[3 * v as usize + a] = (p[a] + s * d[a]) as f32;
+        }
+    }
 }
 
 /// Facet pairs around a non-manifold edge. Facets are sorted by angle about the edge; a facet
