@@ -154,7 +154,10 @@ impl CheckReport {
             ("T-junctions", self.t_junctions),
             ("reversed normals", n.reversed),
             ("inaccurate normals", n.inaccurate),
-            ("self-intersecting facet pairs", self.self_intersections.unwrap_or(0)),
+            (
+                "self-intersecting facet pairs",
+                self.self_intersections.unwrap_or(0),
+            ),
         ];
         if self.facets == 0 {
             v.push(("empty mesh", 1));
@@ -249,7 +252,8 @@ pub fn t_junctions(mesh: &Mesh, topo: &Topology, tolerance: f64) -> Vec<TJunctio
         .fold(0.0, f64::max)
         .max(eps)
         + eps;
-    let key = |p: Vec3| p.map(|x| ((x - bb.min[0].min(bb.min[1]).min(bb.min[2])) / cell).floor() as i64);
+    let key =
+        |p: Vec3| p.map(|x| ((x - bb.min[0].min(bb.min[1]).min(bb.min[2])) / cell).floor() as i64);
     let mut grid: std::collections::HashMap<[i64; 3], Vec<u32>> = Default::default();
     for &v in &verts {
         grid.entry(key(mesh.vertex(v))).or_default().push(v);
@@ -425,7 +429,11 @@ pub fn shell_members(shell_of: &[u32], shells: usize) -> Vec<Vec<u32>> {
 }
 
 /// Checks `mesh`; `normals` are the stored facet normals if the file had them.
-pub fn check(mesh: &Mesh, normals: Option<&[[f32; 3]]>, opts: &CheckOptions) -> Result<CheckReport> {
+pub fn check(
+    mesh: &Mesh,
+    normals: Option<&[[f32; 3]]>,
+    opts: &CheckOptions,
+) -> Result<CheckReport> {
     let nf = mesh.triangle_count();
     let topo = Topology::new(mesh);
     let (shell_of, nshells) = topo.shells(nf);

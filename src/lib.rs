@@ -16,9 +16,9 @@ pub mod output;
 pub mod progress;
 pub mod repair;
 pub mod snap;
-pub mod triangulate;
 pub mod topology;
 pub mod tpms;
+pub mod triangulate;
 pub mod verify;
 
 pub use error::{Error, Result};

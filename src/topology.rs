@@ -185,7 +185,10 @@ impl Topology {
             let hs = self.edge(e);
             if hs.len() == 1 {
                 let (a, b) = half_edge(mesh, hs[0]);
-                out_edges.entry(b).or_default().push(hole_edges.len() as u32);
+                out_edges
+                    .entry(b)
+                    .or_default()
+                    .push(hole_edges.len() as u32);
                 hole_edges.push((b, a));
             }
         }

@@ -148,13 +148,22 @@ pub(crate) fn defects_json(r: &CheckReport) -> serde_json::Value {
 pub(crate) fn print_reading(l: &Loaded) {
     let mut notes = Vec::new();
     if l.polygons_split > 0 {
-        notes.push(format!("{} polygons split into triangles", l.polygons_split));
+        notes.push(format!(
+            "{} polygons split into triangles",
+            l.polygons_split
+        ));
     }
     if l.short_faces > 0 {
-        notes.push(format!("{} faces with fewer than 3 corners skipped", l.short_faces));
+        notes.push(format!(
+            "{} faces with fewer than 3 corners skipped",
+            l.short_faces
+        ));
     }
     if l.tolerance_welded > 0 {
-        notes.push(format!("{} vertices merged by tolerance", l.tolerance_welded));
+        notes.push(format!(
+            "{} vertices merged by tolerance",
+            l.tolerance_welded
+        ));
     }
     if !notes.is_empty() {
         println!("reading   {}", notes.join(", "));
@@ -181,7 +190,10 @@ pub(crate) fn print_summary(r: &CheckReport) {
     }
     if let Some(n) = r.normals {
         if n.unset > 0 {
-            println!("note      {} stored normals are unset (zero or not finite)", n.unset);
+            println!(
+                "note      {} stored normals are unset (zero or not finite)",
+                n.unset
+            );
         }
     }
     if r.self_intersections.is_none() {
@@ -220,6 +232,9 @@ pub(crate) fn print_summary(r: &CheckReport) {
         );
     }
     if r.shells.len() > SHOWN {
-        println!("…         {} more shells (see --json)", r.shells.len() - SHOWN);
+        println!(
+            "…         {} more shells (see --json)",
+            r.shells.len() - SHOWN
+        );
     }
 }

@@ -124,7 +124,9 @@ pub fn parse(data: &[u8], format: Format) -> std::result::Result<Parsed, String>
 /// Reads a mesh file of any supported format.
 pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded> {
     if !(opts.weld_tolerance >= 0.0 && opts.weld_tolerance.is_finite()) {
-        return Err(Error::invalid("weld tolerance must be a finite length ≥ 0 mm"));
+        return Err(Error::invalid(
+            "weld tolerance must be a finite length ≥ 0 mm",
+        ));
     }
     let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let format = Format::from_path(path).unwrap_or_else(|| Format::sniff(&data));

@@ -41,7 +41,9 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
                         .and_then(|s| s.parse().ok())
                         .ok_or_else(|| format!("line {lineno}: bad face index"))?;
                     let abs = match i {
-                        0 => return Err(format!("line {lineno}: face index 0 (OBJ counts from 1)")),
+                        0 => {
+                            return Err(format!("line {lineno}: face index 0 (OBJ counts from 1)"))
+                        }
                         i if i > 0 => i - 1,
                         i => nv + i,
                     };
@@ -62,7 +64,8 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
             sink.corner(i);
         }
         k += n as usize;
-        sink.end_face().map_err(|e| format!("face {}: {e}", f + 1))?;
+        sink.end_face()
+            .map_err(|e| format!("face {}: {e}", f + 1))?;
     }
     sink.finish()
 }
@@ -85,7 +88,8 @@ mod tests {
 
     #[test]
     fn quads_negative_indices_and_slashes() {
-        let text = b"v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nv 0 1 0\r\nf 1/1/1 2/2/2 3//3 4\r\nf -4 -2 -1\n";
+        let text =
+            b"v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nv 0 1 0\r\nf 1/1/1 2/2/2 3//3 4\r\nf -4 -2 -1\n";
         let p = parse(text).unwrap();
         assert_eq!(p.mesh.triangle_count(), 3);
         assert_eq!(p.polygons_split, 1);

@@ -51,15 +51,23 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
     let (_, first) = lines.next().ok_or("empty file")?;
     let mut head = words(first);
     if !keyword_ok(head[0].as_bytes()) {
-        return Err(format!("expected the OFF keyword, found '{}'", trunc(&head[0])));
+        return Err(format!(
+            "expected the OFF keyword, found '{}'",
+            trunc(&head[0])
+        ));
     }
     let four_d = head[0].contains('4');
-    if head.get(1).is_some_and(|w| w.eq_ignore_ascii_case("BINARY")) {
+    if head
+        .get(1)
+        .is_some_and(|w| w.eq_ignore_ascii_case("BINARY"))
+    {
         return Err("binary OFF is not supported".into());
     }
     head.remove(0);
     if head.is_empty() {
-        let (_, l) = lines.next().ok_or("file ends before the vertex and face counts")?;
+        let (_, l) = lines
+            .next()
+            .ok_or("file ends before the vertex and face counts")?;
         head = words(l);
     }
     let count = |i: usize, what: &str| -> Result<u64, String> {
@@ -134,10 +142,15 @@ mod tests {
 
     #[test]
     fn counts_on_the_keyword_line_comments_and_colours() {
-        let text = b"OFF 4 2 0\n# a comment\n0 0 0\n1 0 0\n1 1 0 # c\n0 1 0\n3 0 1 2 255 0 0\n3 0 2 3\n";
+        let text =
+            b"OFF 4 2 0\n# a comment\n0 0 0\n1 0 0\n1 1 0 # c\n0 1 0\n3 0 1 2 255 0 0\n3 0 2 3\n";
         let p = parse(text).unwrap();
         assert_eq!(p.mesh.triangle_count(), 2);
-        assert!(parse(b"OFF\n4000000000 1 0\n0 0 0\n").unwrap_err().contains("ends after 1"));
-        assert!(parse(b"COFF\n3 1 0\n0 0 0 1 1 1 1\n1 0 0 1 1 1 1\n0 1 0 1 1 1 1\n3 0 1 5\n").is_err());
+        assert!(parse(b"OFF\n4000000000 1 0\n0 0 0\n")
+            .unwrap_err()
+            .contains("ends after 1"));
+        assert!(
+            parse(b"COFF\n3 1 0\n0 0 0 1 1 1 1\n1 0 0 1 1 1 1\n0 1 0 1 1 1 1\n3 0 1 5\n").is_err()
+        );
     }
 }

@@ -75,11 +75,19 @@ struct Body<'a> {
 impl Body<'_> {
     fn value(&mut self, t: Scalar) -> Result<f64, String> {
         if self.enc == Encoding::Ascii {
-            while self.data.get(self.pos).is_some_and(|b| b.is_ascii_whitespace()) {
+            while self
+                .data
+                .get(self.pos)
+                .is_some_and(|b| b.is_ascii_whitespace())
+            {
                 self.pos += 1;
             }
             let start = self.pos;
-            while self.data.get(self.pos).is_some_and(|b| !b.is_ascii_whitespace()) {
+            while self
+                .data
+                .get(self.pos)
+                .is_some_and(|b| !b.is_ascii_whitespace())
+            {
                 self.pos += 1;
             }
             if start == self.pos {
@@ -173,7 +181,12 @@ fn header(data: &[u8]) -> Result<(Encoding, Vec<Element>, usize), String> {
                 el.props.push(Prop::Scalar(name.to_string(), t));
             }
             ["end_header"] => break,
-            _ => return Err(format!("unexpected header line '{}'", line.chars().take(40).collect::<String>())),
+            _ => {
+                return Err(format!(
+                    "unexpected header line '{}'",
+                    line.chars().take(40).collect::<String>()
+                ))
+            }
         }
     }
     Ok((enc.ok_or("no format line")?, elements, pos))
@@ -274,8 +287,7 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
                             }
                         }
                         if take {
-                            sink.end_face()
-                                .map_err(|e| format!("face {item}: {e}"))?;
+                            sink.end_face().map_err(|e| format!("face {item}: {e}"))?;
                         }
                     }
                 }

@@ -127,8 +127,8 @@ pub fn parse_facets(data: &[u8]) -> std::result::Result<Parsed, String> {
         .iter()
         .position(|b| !b.is_ascii_whitespace())
         .map(|i| &data[i..]);
-    let looks_ascii = first_word
-        .is_some_and(|w| w.len() >= 5 && w[..5].eq_ignore_ascii_case(b"solid"));
+    let looks_ascii =
+        first_word.is_some_and(|w| w.len() >= 5 && w[..5].eq_ignore_ascii_case(b"solid"));
     if looks_ascii {
         return parse_ascii(data);
     }
@@ -171,7 +171,11 @@ fn parse_binary(data: &[u8], n: usize) -> std::result::Result<Parsed, String> {
 /// line. Keywords in any case; CR, LF or CRLF line ends; several solids in one file; text after
 /// the last `endsolid` ignored. Stored normals may be anything `f32` parses (`nan`, `+inf`).
 fn parse_ascii(data: &[u8]) -> std::result::Result<Parsed, String> {
-    let mut words = Words { data, pos: 0, line: 1 };
+    let mut words = Words {
+        data,
+        pos: 0,
+        line: 1,
+    };
     let mut w = ExactWelder::new(1024);
     let mut normals = Vec::new();
     let num = |words: &mut Words, what: &str| -> std::result::Result<f32, String> {
@@ -237,7 +241,8 @@ fn parse_ascii(data: &[u8]) -> std::result::Result<Parsed, String> {
                     num(&mut words, "vertex coordinate")?,
                     num(&mut words, "vertex coordinate")?,
                 ];
-                w.corner(p).map_err(|e| format!("line {}: {e}", words.line))?;
+                w.corner(p)
+                    .map_err(|e| format!("line {}: {e}", words.line))?;
             }
             let l = words.line;
             match words.next() {

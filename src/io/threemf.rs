@@ -62,13 +62,8 @@ fn attr(e: &BytesStart, name: &str) -> Result<Option<String>, String> {
 }
 
 fn num<T: std::str::FromStr>(e: &BytesStart, name: &str) -> Result<T, String> {
-    let v = attr(e, name)?.ok_or_else(|| {
-        format!(
-            "<{}> without {}",
-            e.local_name().as_ref(),
-            name
-        )
-    })?;
+    let v =
+        attr(e, name)?.ok_or_else(|| format!("<{}> without {}", e.local_name().as_ref(), name))?;
     v.trim()
         .parse()
         .map_err(|_| format!("bad {} '{}'", name, v.chars().take(24).collect::<String>()))
@@ -169,7 +164,12 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
                     "inch" => 25.4,
                     "foot" => 304.8,
                     "meter" => 1000.0,
-                    u => return Err(format!("unknown unit '{}'", u.chars().take(24).collect::<String>())),
+                    u => {
+                        return Err(format!(
+                            "unknown unit '{}'",
+                            u.chars().take(24).collect::<String>()
+                        ))
+                    }
                 };
             }
             "object" => {
@@ -191,18 +191,24 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
             }
             "triangle" => {
                 let id = current.ok_or("<triangle> outside an <object>")?;
-                let o = objects.get_mut(&id).ok_or("<triangle> outside an <object>")?;
+                let o = objects
+                    .get_mut(&id)
+                    .ok_or("<triangle> outside an <object>")?;
                 let t: [u32; 3] = [num(&e, "v1")?, num(&e, "v2")?, num(&e, "v3")?];
                 let nv = o.positions.len() / 3;
                 if t.iter().any(|&i| i as usize >= nv) {
-                    return Err(format!("triangle {t:?} names a vertex past the {nv} vertices"));
+                    return Err(format!(
+                        "triangle {t:?} names a vertex past the {nv} vertices"
+                    ));
                 }
                 o.triangles.extend_from_slice(&t);
                 stored_triangles += 1;
             }
             "component" => {
                 let id = current.ok_or("<component> outside an <object>")?;
-                let o = objects.get_mut(&id).ok_or("<component> outside an <object>")?;
+                let o = objects
+                    .get_mut(&id)
+                    .ok_or("<component> outside an <object>")?;
                 o.components.push((num(&e, "objectid")?, transform(&e)?));
             }
             "item" => items.push((num(&e, "objectid")?, transform(&e)?)),
@@ -213,11 +219,7 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
         return Err("no <build> <item>".into());
     }
     // Triangles after instancing, computed before copying anything.
-    fn count(
-        objects: &HashMap<u64, Object>,
-        id: u64,
-        depth: usize,
-    ) -> Result<u64, String> {
+    fn count(objects: &HashMap<u64, Object>, id: u64, depth: usize) -> Result<u64, String> {
         if depth > MAX_DEPTH {
             return Err("components nested too deeply (or in a cycle)".into());
         }
@@ -310,7 +312,11 @@ pub fn write(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
         }
         writeln!(x, "</vertices>\n<triangles>")?;
         for t in mesh.indices.chunks_exact(3) {
-            writeln!(x, "<triangle v1=\"{}\" v2=\"{}\" v3=\"{}\"/>", t[0], t[1], t[2])?;
+            writeln!(
+                x,
+                "<triangle v1=\"{}\" v2=\"{}\" v3=\"{}\"/>",
+                t[0], t[1], t[2]
+            )?;
         }
         writeln!(
             x,

@@ -201,7 +201,9 @@ mod tests {
         // Points 0.6 apart on a line, tolerance 1: 0 takes 0.6; 1.2 is 1.2 from 0, so it starts a
         // new cluster that takes 1.8 (chaining would have merged all four).
         let mut m = Mesh {
-            positions: vec![0., 0., 0., 0.6, 0., 0., 1.2, 0., 0., 1.8, 0., 0., 0., 5., 0.],
+            positions: vec![
+                0., 0., 0., 0.6, 0., 0., 1.2, 0., 0., 1.8, 0., 0., 0., 5., 0.,
+            ],
             indices: vec![0, 1, 4, 2, 3, 4],
         };
         let merged = weld_tolerance(&mut m, 1.0);

@@ -22,7 +22,7 @@ mod split;
 
 use crate::check::{self, zero_area};
 use crate::error::Result;
-use crate::mesh::{dot, cross, sub, Mesh};
+use crate::mesh::{cross, dot, sub, Mesh};
 use crate::progress::Progress;
 use crate::topology::Topology;
 
@@ -152,7 +152,11 @@ impl Work {
 }
 
 /// Repairs `mesh`. Returns the repaired mesh and what was done.
-pub fn repair(mesh: &Mesh, opts: &RepairOptions, progress: &Progress) -> Result<(Mesh, RepairReport)> {
+pub fn repair(
+    mesh: &Mesh,
+    opts: &RepairOptions,
+    progress: &Progress,
+) -> Result<(Mesh, RepairReport)> {
     let mut w = Work {
         mesh: mesh.clone(),
         topo: None,
@@ -207,7 +211,10 @@ pub fn repair(mesh: &Mesh, opts: &RepairOptions, progress: &Progress) -> Result<
         if copies == 0 {
             w.topo = Some(topo);
         }
-        w.note("non-manifold edges separated", if copies > 0 { edges } else { 0 });
+        w.note(
+            "non-manifold edges separated",
+            if copies > 0 { edges } else { 0 },
+        );
         w.note("vertices duplicated to separate touching shells", copies);
     }
 
@@ -243,7 +250,10 @@ pub fn repair(mesh: &Mesh, opts: &RepairOptions, progress: &Progress) -> Result<
             let st = holes::fill(&mut w.mesh, &loops, opts.fair)?;
             w.topo = None;
             w.note("planar holes filled by triangulating the loop", st.planar);
-            w.note("curved holes filled by CGAL (triangulate, refine, fair)", st.curved);
+            w.note(
+                "curved holes filled by CGAL (triangulate, refine, fair)",
+                st.curved,
+            );
             w.note("facets added to fill holes", st.facets_added);
             holes_left = st.failed;
         }

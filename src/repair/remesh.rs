@@ -11,7 +11,9 @@ use crate::mesh::Mesh;
 /// number of active voxels used.
 pub fn remesh(mesh: &Mesh, voxel: f64) -> Result<(Mesh, u64)> {
     if !(voxel > 0.0 && voxel.is_finite()) {
-        return Err(Error::invalid("remesh voxel size must be a positive length in mm"));
+        return Err(Error::invalid(
+            "remesh voxel size must be a positive length in mm",
+        ));
     }
     if let Some(b) = mesh.bounds() {
         let s = b.size();

@@ -17,7 +17,10 @@ pub fn split_t_junctions(mesh: &mut Mesh, tjs: &[TJunction]) -> u64 {
     // Per half-edge, the inner vertices by position along it.
     let mut on_edge: std::collections::HashMap<u32, Vec<(f64, u32)>> = Default::default();
     for tj in tjs {
-        on_edge.entry(tj.half_edge).or_default().push((tj.t, tj.vertex));
+        on_edge
+            .entry(tj.half_edge)
+            .or_default()
+            .push((tj.t, tj.vertex));
     }
     let mut inserted = 0u64;
     let mut out = Vec::with_capacity(mesh.indices.len() + 6 * on_edge.len());
