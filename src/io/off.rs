@@ -105,7 +105,7 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
             .first()
             .and_then(|s| s.parse().ok())
             .ok_or_else(|| format!("line {ln}: bad face"))?;
-        if w.len() < n + 1 {
+        if n >= w.len() {
             return Err(format!("line {ln}: face says {n} corners but lists fewer"));
         }
         for s in &w[1..=n] {

@@ -69,7 +69,8 @@ fn num<T: std::str::FromStr>(e: &BytesStart, name: &str) -> Result<T, String> {
         .map_err(|_| format!("bad {} '{}'", name, v.chars().take(24).collect::<String>()))
 }
 
-fn transform(e: &BytesStart) -> Result<Transform, String> {
+/// A `transform` attribute, its translation converted from model units to mm.
+fn transform(e: &BytesStart, scale: f64) -> Result<Transform, String> {
     let Some(t) = attr(e, "transform")? else {
         return Ok(IDENTITY);
     };
@@ -81,7 +82,11 @@ fn transform(e: &BytesStart) -> Result<Transform, String> {
     if v.len() != 12 || !v.iter().all(|x| x.is_finite()) {
         return Err("a transform needs 12 finite numbers".into());
     }
-    Ok(v.try_into().expect("12 values"))
+    let mut m: Transform = v.try_into().expect("12 values");
+    for t in &mut m[9..] {
+        *t *= scale;
+    }
+    Ok(m)
 }
 
 fn read_entry(zip: &mut zip::ZipArchive<Cursor<&[u8]>>, name: &str) -> Result<Vec<u8>, String> {
@@ -209,9 +214,9 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
                 let o = objects
                     .get_mut(&id)
                     .ok_or("<component> outside an <object>")?;
-                o.components.push((num(&e, "objectid")?, transform(&e)?));
+                o.components.push((num(&e, "objectid")?, transform(&e, scale)?));
             }
-            "item" => items.push((num(&e, "objectid")?, transform(&e)?)),
+            "item" => items.push((num(&e, "objectid")?, transform(&e, scale)?)),
             _ => {}
         }
     }
@@ -346,5 +351,18 @@ mod tests {
             indices: vec![0, 0, 1],
         };
         assert!(write(&degenerate, &mut Vec::new()).is_err());
+    }
+
+    #[test]
+    fn units_components_and_build_transforms_compose() {
+        // Centimetres; object 2 = tetra 1 twice, the second moved 5 cm along x; the build item
+        // scales by 2 and lifts by 1 cm. Model path given by _rels/.rels (not the default).
+        let data = include_bytes!("../../fuzz/corpus/threemf/components-transforms.3mf");
+        let m = parse(data).unwrap().mesh;
+        assert_eq!(m.triangle_count(), 8);
+        let b = m.bounds().unwrap();
+        assert!((b.min[0] - 0.0).abs() < 1e-4 && (b.max[0] - 120.0).abs() < 1e-4, "{b:?}");
+        assert!((b.min[2] - 10.0).abs() < 1e-4 && (b.max[2] - 30.0).abs() < 1e-4, "{b:?}");
+        assert!((m.volume() - 2.0 * 20.0f64.powi(3) / 6.0).abs() < 1e-3);
     }
 }

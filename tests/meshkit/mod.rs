@@ -400,41 +400,64 @@ pub fn sphere(r: f64, n: usize) -> Vec<Tri> {
     t
 }
 
-/// trimesh's view of a mesh file (merging vertices as trimesh does on load).
+/// trimesh's view of a mesh file (merging vertices as trimesh does on load). One python3
+/// process serves the whole test binary (importing trimesh takes over a second).
 pub fn trimesh(path: &Path) -> serde_json::Value {
-    let script = r#"
-import json, sys
-import numpy as np
+    use std::io::{BufRead, BufReader, Write};
+    use std::process::{Child, ChildStdout, Command, Stdio};
+    use std::sync::{Mutex, OnceLock};
+    const SCRIPT: &str = r#"
+import json, sys, warnings
+warnings.filterwarnings("ignore")
 import trimesh
 from trimesh import grouping
-m = trimesh.load(sys.argv[1], force='mesh', process=True)
-edges = m.edges_sorted
-once = grouping.group_rows(edges, require_count=1)
-counts = {}
-for e in map(tuple, edges):
-    counts[e] = counts.get(e, 0) + 1
-print(json.dumps({
-  "faces": int(len(m.faces)),
-  "vertices": int(len(m.vertices)),
-  "edges_unique": int(len(m.edges_unique)),
-  "boundary_edges": int(len(once)),
-  "non_manifold_edges": int(sum(1 for c in counts.values() if c > 2)),
-  "watertight": bool(m.is_watertight),
-  "winding_consistent": bool(m.is_winding_consistent),
-  "volume": float(m.volume),
-  "area": float(m.area),
-  "euler": int(m.euler_number),
-  "bodies": int(len(m.split(only_watertight=False))),
-}))
+for line in sys.stdin:
+    path = line.rstrip("\n")
+    try:
+        m = trimesh.load(path, force='mesh', process=True)
+        edges = m.edges_sorted
+        once = grouping.group_rows(edges, require_count=1)
+        counts = {}
+        for e in map(tuple, edges):
+            counts[e] = counts.get(e, 0) + 1
+        out = {
+          "faces": int(len(m.faces)),
+          "vertices": int(len(m.vertices)),
+          "edges_unique": int(len(m.edges_unique)),
+          "boundary_edges": int(len(once)),
+          "non_manifold_edges": int(sum(1 for c in counts.values() if c > 2)),
+          "watertight": bool(m.is_watertight),
+          "winding_consistent": bool(m.is_winding_consistent),
+          "volume": float(m.volume),
+          "area": float(m.area),
+          "euler": int(m.euler_number),
+          "bodies": int(len(m.split(only_watertight=False))),
+        }
+    except Exception as e:
+        out = {"error": repr(e)}
+    print(json.dumps(out), flush=True)
 "#;
-    let out = std::process::Command::new("python3")
-        .args(["-c", script, path.to_str().unwrap()])
-        .output()
-        .expect("python3 (run scripts/install-deps.sh)");
+    static WORKER: OnceLock<Mutex<(Child, BufReader<ChildStdout>)>> = OnceLock::new();
+    let worker = WORKER.get_or_init(|| {
+        let mut child = Command::new("python3")
+            .args(["-c", SCRIPT])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .expect("python3 with trimesh (run scripts/install-deps.sh)");
+        let out = BufReader::new(child.stdout.take().unwrap());
+        Mutex::new((child, out))
+    });
+    let mut w = worker.lock().unwrap_or_else(|e| e.into_inner());
+    let (child, out) = &mut *w;
+    writeln!(child.stdin.as_mut().unwrap(), "{}", path.display()).unwrap();
+    let mut line = String::new();
+    out.read_line(&mut line).unwrap();
     assert!(
-        out.status.success(),
-        "trimesh failed (run scripts/install-deps.sh): {}",
-        String::from_utf8_lossy(&out.stderr)
+        !line.is_empty(),
+        "trimesh worker died (run scripts/install-deps.sh to install trimesh)"
     );
-    serde_json::from_slice(&out.stdout).unwrap()
+    let v: serde_json::Value = serde_json::from_str(&line).unwrap();
+    assert!(v.get("error").is_none(), "trimesh on {}: {v}", path.display());
+    v
 }
