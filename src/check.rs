@@ -575,7 +575,7 @@ pub fn check(
             Orientation::Inconsistent
         } else if !r.closed {
             Orientation::Open
-        } else if (r.volume > 0.0) == (depth[s].unwrap_or(0) % 2 == 0) {
+        } else if (r.volume > 0.0) == depth[s].unwrap_or(0).is_multiple_of(2) {
             Orientation::Outward
         } else {
             inward_shells += 1;

@@ -139,7 +139,7 @@ impl Topology {
         let mut id = vec![u32::MAX; facets];
         let mut root_id = vec![u32::MAX; facets];
         let mut n = 0u32;
-        for f in 0..facets {
+        for (f, slot) in id.iter_mut().enumerate() {
             if !self.active[f] {
                 continue;
             }
@@ -148,7 +148,7 @@ impl Topology {
                 root_id[r] = n;
                 n += 1;
             }
-            id[f] = root_id[r];
+            *slot = root_id[r];
         }
         (id, n as usize)
     }

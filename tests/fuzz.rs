@@ -68,15 +68,31 @@ fn every_reader_survives_fuzzing() {
         assert!(
             out.status.success(),
             "fuzz target {t} failed:\n{}",
-            log.lines().rev().take(60).collect::<Vec<_>>().into_iter().rev().collect::<Vec<_>>().join("\n")
+            log.lines()
+                .rev()
+                .take(60)
+                .collect::<Vec<_>>()
+                .into_iter()
+                .rev()
+                .collect::<Vec<_>>()
+                .join("\n")
         );
         // libFuzzer ends with "Done N runs in S second(s)".
         let runs: u64 = log
             .lines()
-            .find_map(|l| l.strip_prefix("Done ")?.split_whitespace().next()?.parse().ok())
+            .find_map(|l| {
+                l.strip_prefix("Done ")?
+                    .split_whitespace()
+                    .next()?
+                    .parse()
+                    .ok()
+            })
             .unwrap_or_else(|| panic!("no run count from libFuzzer for {t}:\n{log}"));
         assert!(runs > 1000, "{t}: only {runs} executions in {SECONDS} s");
         summary.push(format!("{t} {runs}"));
     }
-    eprintln!("fuzz executions in {SECONDS} s per target: {}", summary.join(", "));
+    eprintln!(
+        "fuzz executions in {SECONDS} s per target: {}",
+        summary.join(", ")
+    );
 }

@@ -28,6 +28,13 @@ defects are found; 2 when the file cannot be read.";
 pub struct CheckArgs {
     /// Mesh file: .stl, .obj, .off, .ply or .3mf (others are recognised by content).
     pub file: PathBuf,
+    #[command(flatten)]
+    pub common: CheckFlags,
+}
+
+/// Options shared by `check` and `repair`.
+#[derive(Args)]
+pub struct CheckFlags {
     /// Print the result as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -48,18 +55,18 @@ pub(crate) fn load(path: &Path, weld_tolerance: f64) -> Result<Loaded> {
 }
 
 pub fn run(a: &CheckArgs, quiet: bool) -> Result<i32> {
-    if let Some(r) = &a.report {
+    if let Some(r) = &a.common.report {
         latvox::output::check_writable(r)?;
     }
     let progress = latvox::progress::Progress::new(quiet);
     let loaded = {
         let _s = progress.stage("reading");
-        load(&a.file, a.weld_tolerance)?
+        load(&a.file, a.common.weld_tolerance)?
     };
     let mesh = &loaded.mesh;
     let opts = CheckOptions {
-        self_intersections: !a.no_self_intersection,
-        tolerance: a.weld_tolerance,
+        self_intersections: !a.common.no_self_intersection,
+        tolerance: a.common.weld_tolerance,
     };
     let report = {
         let _s = progress.stage("checking");
@@ -87,22 +94,8 @@ pub fn run(a: &CheckArgs, quiet: bool) -> Result<i32> {
         "defects": defects_json(&report),
         "cgal": cgal,
     });
-    if let Some(r) = &a.report {
-        super::write_json(r, &v)?;
-    }
-    if a.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&v).expect("JSON of plain values")
-        );
-    } else {
-        println!(
-            "{} ({}, {} facets read)",
-            a.file.display(),
-            loaded.format.name(),
-            mesh.triangle_count()
-        );
-        print_reading(&loaded);
+    if !super::emit_json(a.common.report.as_deref(), a.common.json, &v)? {
+        print_header(&a.file, &loaded);
         print_summary(&report);
         println!(
             "CGAL      closed {}  outward {}  manifold {}  self-intersections {}",
@@ -145,7 +138,14 @@ pub(crate) fn defects_json(r: &CheckReport) -> serde_json::Value {
         .into()
 }
 
-pub(crate) fn print_reading(l: &Loaded) {
+/// The file line of a summary, and what reading did.
+pub(crate) fn print_header(path: &Path, l: &Loaded) {
+    println!(
+        "{} ({}, {} facets read)",
+        path.display(),
+        l.format.name(),
+        l.mesh.triangle_count()
+    );
     let mut notes = Vec::new();
     if l.polygons_split > 0 {
         notes.push(format!(

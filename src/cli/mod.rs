@@ -101,6 +101,25 @@ pub(crate) fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<
     })
 }
 
+/// Writes `value` to `report` if given and prints it if `json`; returns whether it was printed
+/// (the caller prints its human summary otherwise).
+pub(crate) fn emit_json(
+    report: Option<&Path>,
+    json: bool,
+    value: &serde_json::Value,
+) -> Result<bool> {
+    if let Some(r) = report {
+        write_json(r, value)?;
+    }
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(value).expect("JSON of plain values")
+        );
+    }
+    Ok(json)
+}
+
 pub(crate) fn yes(b: bool) -> &'static str {
     if b {
         "yes"

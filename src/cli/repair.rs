@@ -1,7 +1,7 @@
 //! `latvox repair`: mends a mesh file and reports every change by kind and count, with the check
 //! before and after.
 
-use super::check::{defects_json, load, print_reading, print_summary, reading_json};
+use super::check::{defects_json, load, print_header, print_summary, reading_json};
 use clap::Args;
 use latvox::check::CheckOptions;
 use latvox::repair::RepairOptions;
@@ -37,15 +37,8 @@ pub struct RepairArgs {
     /// ASCII STL or ASCII PLY output (binary by default).
     #[arg(long)]
     pub ascii: bool,
-    /// Print the result as JSON on stdout.
-    #[arg(long)]
-    pub json: bool,
-    /// Also write the JSON result to this file.
-    #[arg(long, value_name = "FILE.json")]
-    pub report: Option<PathBuf>,
-    /// Merge vertices closer than this (mm) when reading; exact matches are always merged.
-    #[arg(long, value_name = "MM", default_value_t = 0.0, value_parser = super::parse_length0)]
-    pub weld_tolerance: f64,
+    #[command(flatten)]
+    pub common: super::check::CheckFlags,
     /// Merge border vertices closer than this (mm) [default: 10⁻⁶ of the part's diagonal].
     #[arg(long, value_name = "MM", value_parser = super::parse_length0)]
     pub stitch_tolerance: Option<f64>,
@@ -61,9 +54,6 @@ pub struct RepairArgs {
     /// Rebuild the part through an OpenVDB level set with this voxel size (mm).
     #[arg(long, value_name = "VOXEL", value_parser = super::parse_positive)]
     pub remesh: Option<f64>,
-    /// Skip CGAL's self-intersection test before and after.
-    #[arg(long)]
-    pub no_self_intersection: bool,
 }
 
 pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
@@ -74,17 +64,17 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
             a.output.display()
         )));
     }
-    if let Some(r) = &a.report {
+    if let Some(r) = &a.common.report {
         latvox::output::check_writable(r)?;
     }
     let progress = latvox::progress::Progress::new(quiet);
     let loaded = {
         let _s = progress.stage("reading");
-        load(&a.input, a.weld_tolerance)?
+        load(&a.input, a.common.weld_tolerance)?
     };
     let copts = CheckOptions {
-        self_intersections: !a.no_self_intersection,
-        tolerance: a.weld_tolerance,
+        self_intersections: !a.common.no_self_intersection,
+        tolerance: a.common.weld_tolerance,
     };
     let before = {
         let _s = progress.stage("checking the input");
@@ -126,22 +116,8 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
         "defects_after": defects_json(&after),
         "valid_solid": after.valid_solid,
     });
-    if let Some(r) = &a.report {
-        super::write_json(r, &v)?;
-    }
-    if a.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&v).expect("JSON of plain values")
-        );
-    } else {
-        println!(
-            "{} ({}, {} facets read)",
-            a.input.display(),
-            loaded.format.name(),
-            loaded.mesh.triangle_count()
-        );
-        print_reading(&loaded);
+    if !super::emit_json(a.common.report.as_deref(), a.common.json, &v)? {
+        print_header(&a.input, &loaded);
         let d = before.defects();
         if d.is_empty() {
             println!("before    no defects");

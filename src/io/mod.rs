@@ -282,3 +282,63 @@ impl PolygonSink {
 pub(crate) fn bounded(count: u64, bytes_left: usize, min_bytes: usize) -> usize {
     count.min((bytes_left / min_bytes.max(1)) as u64) as usize
 }
+
+/// Whitespace-separated words of a byte buffer, with line counting (CR, LF and CRLF each end
+/// one line).
+pub(crate) struct Words<'a> {
+    data: &'a [u8],
+    pub pos: usize,
+    pub line: usize,
+}
+
+impl<'a> Words<'a> {
+    pub fn new(data: &'a [u8]) -> Self {
+        Words {
+            data,
+            pos: 0,
+            line: 1,
+        }
+    }
+
+    fn skip_space(&mut self) {
+        while let Some(&b) = self.data.get(self.pos) {
+            if !b.is_ascii_whitespace() {
+                break;
+            }
+            if b == b'\n' || (b == b'\r' && self.data.get(self.pos + 1) != Some(&b'\n')) {
+                self.line += 1;
+            }
+            self.pos += 1;
+        }
+    }
+
+    pub fn next(&mut self) -> Option<&'a [u8]> {
+        self.skip_space();
+        let start = self.pos;
+        while self
+            .data
+            .get(self.pos)
+            .is_some_and(|b| !b.is_ascii_whitespace())
+        {
+            self.pos += 1;
+        }
+        (self.pos > start).then(|| &self.data[start..self.pos])
+    }
+
+    pub fn peek(&mut self) -> Option<&'a [u8]> {
+        let (pos, line) = (self.pos, self.line);
+        let t = self.next();
+        self.pos = pos;
+        self.line = line;
+        t
+    }
+
+    pub fn skip_line(&mut self) {
+        while let Some(&b) = self.data.get(self.pos) {
+            if b == b'\n' || b == b'\r' {
+                break;
+            }
+            self.pos += 1;
+        }
+    }
+}

@@ -4,7 +4,7 @@
 //! Element counts only bound loops; the data must actually be there.
 //! Written as binary little-endian (float coordinates, uchar/uint face lists) or ASCII.
 
-use super::{Parsed, PolygonSink};
+use super::{Parsed, PolygonSink, Words};
 use crate::mesh::Mesh;
 use std::io::Write;
 
@@ -75,25 +75,12 @@ struct Body<'a> {
 impl Body<'_> {
     fn value(&mut self, t: Scalar) -> Result<f64, String> {
         if self.enc == Encoding::Ascii {
-            while self
-                .data
-                .get(self.pos)
-                .is_some_and(|b| b.is_ascii_whitespace())
-            {
-                self.pos += 1;
-            }
+            let mut w = Words::new(self.data);
+            w.pos = self.pos;
+            let tok = w.next().ok_or("file ends inside the data")?;
             let start = self.pos;
-            while self
-                .data
-                .get(self.pos)
-                .is_some_and(|b| !b.is_ascii_whitespace())
-            {
-                self.pos += 1;
-            }
-            if start == self.pos {
-                return Err("file ends inside the data".into());
-            }
-            return std::str::from_utf8(&self.data[start..self.pos])
+            self.pos = w.pos;
+            return std::str::from_utf8(tok)
                 .ok()
                 .and_then(|s| s.parse::<f64>().ok())
                 .ok_or_else(|| format!("bad number at byte {start}"));

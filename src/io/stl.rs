@@ -4,7 +4,7 @@
 //! compare them with the winding.
 
 use super::weld::ExactWelder;
-use super::Parsed;
+use super::{Parsed, Words};
 use crate::error::{Error, Result};
 use crate::mesh::{cross, norm, sub, Mesh};
 use std::io::Write;
@@ -171,11 +171,7 @@ fn parse_binary(data: &[u8], n: usize) -> std::result::Result<Parsed, String> {
 /// line. Keywords in any case; CR, LF or CRLF line ends; several solids in one file; text after
 /// the last `endsolid` ignored. Stored normals may be anything `f32` parses (`nan`, `+inf`).
 fn parse_ascii(data: &[u8]) -> std::result::Result<Parsed, String> {
-    let mut words = Words {
-        data,
-        pos: 0,
-        line: 1,
-    };
+    let mut words = Words::new(data);
     let mut w = ExactWelder::new(1024);
     let mut normals = Vec::new();
     let num = |words: &mut Words, what: &str| -> std::result::Result<f32, String> {
@@ -272,58 +268,6 @@ fn parse_ascii(data: &[u8]) -> std::result::Result<Parsed, String> {
         normals: Some(normals),
         ..Parsed::default()
     })
-}
-
-/// Whitespace-separated words of a byte buffer, with line counting (CR, LF and CRLF each end
-/// one line).
-struct Words<'a> {
-    data: &'a [u8],
-    pos: usize,
-    line: usize,
-}
-
-impl<'a> Words<'a> {
-    fn skip_space(&mut self) {
-        while let Some(&b) = self.data.get(self.pos) {
-            if !b.is_ascii_whitespace() {
-                break;
-            }
-            if b == b'\n' || (b == b'\r' && self.data.get(self.pos + 1) != Some(&b'\n')) {
-                self.line += 1;
-            }
-            self.pos += 1;
-        }
-    }
-
-    fn next(&mut self) -> Option<&'a [u8]> {
-        self.skip_space();
-        let start = self.pos;
-        while self
-            .data
-            .get(self.pos)
-            .is_some_and(|b| !b.is_ascii_whitespace())
-        {
-            self.pos += 1;
-        }
-        (self.pos > start).then(|| &self.data[start..self.pos])
-    }
-
-    fn peek(&mut self) -> Option<&'a [u8]> {
-        let (pos, line) = (self.pos, self.line);
-        let t = self.next();
-        self.pos = pos;
-        self.line = line;
-        t
-    }
-
-    fn skip_line(&mut self) {
-        while let Some(&b) = self.data.get(self.pos) {
-            if b == b'\n' || b == b'\r' {
-                break;
-            }
-            self.pos += 1;
-        }
-    }
 }
 
 /// Writes `mesh` to `path` atomically.

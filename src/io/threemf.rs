@@ -117,11 +117,12 @@ fn model_path(zip: &mut zip::ZipArchive<Cursor<&[u8]>>) -> String {
     let mut r = quick_xml::Reader::from_str(text);
     while let Ok(ev) = r.read_event() {
         match ev {
-            Event::Empty(e) | Event::Start(e) if e.local_name().as_ref() == "Relationship" => {
-                if attr(&e, "Type").ok().flatten().as_deref() == Some(REL_3DMODEL) {
-                    if let Ok(Some(t)) = attr(&e, "Target") {
-                        return t.trim_start_matches('/').to_string();
-                    }
+            Event::Empty(e) | Event::Start(e)
+                if e.local_name().as_ref() == "Relationship"
+                    && attr(&e, "Type").ok().flatten().as_deref() == Some(REL_3DMODEL) =>
+            {
+                if let Ok(Some(t)) = attr(&e, "Target") {
+                    return t.trim_start_matches('/').to_string();
                 }
             }
             Event::Eof => break,
@@ -214,7 +215,8 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
                 let o = objects
                     .get_mut(&id)
                     .ok_or("<component> outside an <object>")?;
-                o.components.push((num(&e, "objectid")?, transform(&e, scale)?));
+                o.components
+                    .push((num(&e, "objectid")?, transform(&e, scale)?));
             }
             "item" => items.push((num(&e, "objectid")?, transform(&e, scale)?)),
             _ => {}
@@ -361,8 +363,14 @@ mod tests {
         let m = parse(data).unwrap().mesh;
         assert_eq!(m.triangle_count(), 8);
         let b = m.bounds().unwrap();
-        assert!((b.min[0] - 0.0).abs() < 1e-4 && (b.max[0] - 120.0).abs() < 1e-4, "{b:?}");
-        assert!((b.min[2] - 10.0).abs() < 1e-4 && (b.max[2] - 30.0).abs() < 1e-4, "{b:?}");
+        assert!(
+            (b.min[0] - 0.0).abs() < 1e-4 && (b.max[0] - 120.0).abs() < 1e-4,
+            "{b:?}"
+        );
+        assert!(
+            (b.min[2] - 10.0).abs() < 1e-4 && (b.max[2] - 30.0).abs() < 1e-4,
+            "{b:?}"
+        );
         assert!((m.volume() - 2.0 * 20.0f64.powi(3) / 6.0).abs() < 1e-3);
     }
 }

@@ -162,7 +162,7 @@ pub fn cluster(points: &[[f64; 3]], tol: f64) -> Vec<usize> {
 /// Merges vertices closer than `tol` mm (see the module notes); returns how many vertices were
 /// merged away. Unreferenced positions are dropped from the result.
 pub fn weld_tolerance(mesh: &mut Mesh, tol: f64) -> u64 {
-    if !(tol > 0.0) {
+    if tol.is_nan() || tol <= 0.0 {
         return 0;
     }
     let nv = mesh.vertex_count();

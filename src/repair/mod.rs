@@ -340,7 +340,7 @@ pub fn repair(
 
 /// Merges boundary vertices within `tol` of each other. Returns vertices merged away.
 fn stitch(w: &mut Work, tol: f64) -> u64 {
-    if !(tol > 0.0) {
+    if tol.is_nan() || tol <= 0.0 {
         return 0;
     }
     let (mesh, topo) = w.parts();

@@ -147,8 +147,8 @@ fn separate(mesh: &mut Mesh, split: &[u32], first_copy: usize) {
             let e = moved.entry(v).or_insert(([0.0; 3], 0, f64::INFINITY));
             for j in [t[(k + 1) % 3], t[(k + 2) % 3]] {
                 let q = mesh.vertex(j);
-                for a in 0..3 {
-                    e.0[a] += q[a];
+                for (s, x) in e.0.iter_mut().zip(q) {
+                    *s += x;
                 }
                 e.1 += 1;
                 e.2 = e.2.min(norm(sub(q, p)));

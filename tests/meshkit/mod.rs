@@ -458,6 +458,10 @@ for line in sys.stdin:
         "trimesh worker died (run scripts/install-deps.sh to install trimesh)"
     );
     let v: serde_json::Value = serde_json::from_str(&line).unwrap();
-    assert!(v.get("error").is_none(), "trimesh on {}: {v}", path.display());
+    assert!(
+        v.get("error").is_none(),
+        "trimesh on {}: {v}",
+        path.display()
+    );
     v
 }
