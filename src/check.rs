@@ -184,28 +184,41 @@ pub fn zero_area(mesh: &Mesh, f: usize) -> bool {
 }
 
 /// Facets that repeat another facet's vertex set (either winding): all but the first copy.
+///
+/// Copies share every edge, so they are found within the edge groups: each facet is looked at
+/// on the edge between its two smallest vertices, among the facets there with the same third.
 pub fn duplicate_facets(mesh: &Mesh, topo: &Topology) -> Vec<u32> {
-    let mut keys: Vec<(u128, u32)> = (0..mesh.triangle_count())
+    let sorted = |f: u32| {
+        let i = 3 * f as usize;
+        let mut t = [mesh.indices[i], mesh.indices[i + 1], mesh.indices[i + 2]];
+        t.sort_unstable();
+        t
+    };
+    let mut out: Vec<u32> = (0..topo.edge_count())
         .into_par_iter()
-        .filter(|&f| topo.active[f])
-        .map(|f| {
-            let mut t = [
-                mesh.indices[3 * f],
-                mesh.indices[3 * f + 1],
-                mesh.indices[3 * f + 2],
-            ];
-            t.sort_unstable();
-            (
-                t[0] as u128 | (t[1] as u128) << 32 | (t[2] as u128) << 64,
-                f as u32,
-            )
+        .filter(|&e| topo.edge(e).len() >= 2)
+        .flat_map_iter(|e| {
+            let hs = topo.edge(e);
+            let (a, b) = half_edge(mesh, hs[0]);
+            let (lo, hi) = (a.min(b), a.max(b));
+            // Facets whose two smallest vertices are this edge, by their third vertex.
+            let mut here: Vec<(u32, u32)> = hs
+                .iter()
+                .map(|&h| (h / 3, sorted(h / 3)))
+                .filter(|(_, t)| t[0] == lo && t[1] == hi)
+                .map(|(f, t)| (t[2], f))
+                .collect();
+            here.sort_unstable();
+            let dups: Vec<u32> = here
+                .windows(2)
+                .filter(|w| w[0].0 == w[1].0)
+                .map(|w| w[1].1)
+                .collect();
+            dups
         })
         .collect();
-    keys.par_sort_unstable();
-    keys.windows(2)
-        .filter(|w| w[0].0 == w[1].0)
-        .map(|w| w[1].1)
-        .collect()
+    out.sort_unstable();
+    out
 }
 
 /// A vertex lying inside an edge.
@@ -514,17 +527,27 @@ pub fn check(
 
     let (_, non_orientable) = orientation(mesh, &topo, &shell_of, nshells);
 
-    // Per shell measures.
+    // Per shell measures. Vertices counted with a last-seen marker (a vertex shared by shells
+    // touching there counts in each).
+    let mut shell_vertices = vec![0u64; nshells];
+    {
+        let mut seen_in = vec![u32::MAX; nv];
+        for (s, fs) in members.iter().enumerate() {
+            for &f in fs {
+                for k in 0..3 {
+                    let v = mesh.indices[3 * f as usize + k] as usize;
+                    if seen_in[v] != s as u32 {
+                        seen_in[v] = s as u32;
+                        shell_vertices[s] += 1;
+                    }
+                }
+            }
+        }
+    }
     let mut shell_reports: Vec<ShellReport> = members
         .par_iter()
         .enumerate()
         .map(|(s, fs)| {
-            let mut vs: Vec<u32> = fs
-                .iter()
-                .flat_map(|&f| mesh.indices[3 * f as usize..3 * f as usize + 3].to_vec())
-                .collect();
-            vs.sort_unstable();
-            vs.dedup();
             let (mut volume, mut area) = (0.0, 0.0);
             for &f in fs {
                 let [a, b, c] = mesh.triangle(f as usize);
@@ -532,12 +555,12 @@ pub fn check(
                 area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
             }
             let [edges, boundary_edges, nm] = sh[s];
-            let euler = vs.len() as i64 - edges as i64 + fs.len() as i64;
+            let euler = shell_vertices[s] as i64 - edges as i64 + fs.len() as i64;
             let closed = boundary_edges == 0 && nm == 0;
             let orientable = !non_orientable[s];
             ShellReport {
                 facets: fs.len() as u64,
-                vertices: vs.len() as u64,
+                vertices: shell_vertices[s],
                 edges,
                 boundary_edges,
                 non_manifold_edges: nm,

@@ -2,9 +2,9 @@
 //! facets that use them, shells (facets connected through shared edges), vertex fans, and the
 //! loops that bound holes. `check` counts with it; `repair` decides with it.
 //!
-//! Edges come from sorting the 3F half-edges by their (smaller, larger) vertex pair — one
-//! parallel sort, then linear scans — which is faster than hashing at a million facets and gives
-//! a deterministic order. Facets with a repeated vertex index take no part (they have no proper
+//! Edges come from grouping the 3F half-edges by their (smaller, larger) vertex pair — a counting
+//! sort on the smaller vertex, then a sort of each small bucket — in linear time, faster than
+//! hashing at a million facets, and in a deterministic order (by vertex pair). Facets with a repeated vertex index take no part (they have no proper
 //! edges); `check` counts them separately.
 
 use crate::mesh::Mesh;
@@ -67,26 +67,43 @@ impl Topology {
             .into_par_iter()
             .map(|f| !repeats_vertex(mesh, f))
             .collect();
-        let mut keyed: Vec<(u64, u32)> = (0..nf)
-            .into_par_iter()
-            .filter(|&f| active[f])
-            .flat_map_iter(|f| {
-                (0..3).map(move |k| {
-                    let h = (3 * f + k) as u32;
-                    let (a, b) = half_edge(mesh, h);
-                    let key = (a.min(b) as u64) << 32 | a.max(b) as u64;
-                    (key, h)
-                })
-            })
-            .collect();
-        keyed.par_sort_unstable();
-        let mut edge_start = Vec::with_capacity(keyed.len() / 2 + 1);
-        for i in 0..keyed.len() {
-            if i == 0 || keyed[i].0 != keyed[i - 1].0 {
-                edge_start.push(i as u32);
+        // Counting sort by the smaller vertex, then each (small) bucket by the larger one.
+        let nv = mesh.vertex_count();
+        let mut start = vec![0u32; nv + 1];
+        for (f, t) in mesh.indices.chunks_exact(3).enumerate() {
+            if active[f] {
+                for k in 0..3 {
+                    start[t[k].min(t[(k + 1) % 3]) as usize + 1] += 1;
+                }
             }
         }
-        edge_start.push(keyed.len() as u32);
+        for v in 0..nv {
+            start[v + 1] += start[v];
+        }
+        let total = start[nv] as usize;
+        let mut fill = start.clone();
+        let mut keyed = vec![(0u32, 0u32); total];
+        for (f, t) in mesh.indices.chunks_exact(3).enumerate() {
+            if active[f] {
+                for k in 0..3 {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    let slot = &mut fill[a.min(b) as usize];
+                    keyed[*slot as usize] = (a.max(b), (3 * f + k) as u32);
+                    *slot += 1;
+                }
+            }
+        }
+        let mut edge_start = Vec::with_capacity(total / 2 + 1);
+        for v in 0..nv {
+            let bucket = &mut keyed[start[v] as usize..start[v + 1] as usize];
+            bucket.sort_unstable();
+            for i in 0..bucket.len() {
+                if i == 0 || bucket[i].0 != bucket[i - 1].0 {
+                    edge_start.push(start[v] + i as u32);
+                }
+            }
+        }
+        edge_start.push(total as u32);
         let half = keyed.into_iter().map(|(_, h)| h).collect();
         Topology {
             active,

@@ -72,10 +72,14 @@ pub fn run(a: &CheckArgs, quiet: bool) -> Result<i32> {
         let _s = progress.stage("checking");
         latvox::check::check(mesh, loaded.normals.as_deref(), &opts)?
     };
-    let cgal = {
+    let mut cgal = {
         let _s = progress.stage("CGAL checks");
-        latvox::verify::verify(mesh, opts.self_intersections)?
+        latvox::verify::verify(mesh, false)?
     };
+    // The check above already ran CGAL's self-intersection test (on the facets that are neither
+    // degenerate nor duplicate); it is not run twice.
+    cgal.self_intersection_checked = report.self_intersections.is_some();
+    cgal.self_intersecting = report.self_intersections.unwrap_or(0) > 0;
     let edges = mesh.edge_stats();
     let ok = report.valid_solid
         && cgal.manifold

@@ -97,7 +97,19 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
     let after = {
         let _s = progress.stage("checking the written file");
         let written = load(&a.output, 0.0)?;
-        latvox::check::check(&written.mesh, written.normals.as_deref(), &copts)?
+        // Unchanged geometry keeps its self-intersection count: CGAL's test is not run again.
+        let unchanged = mesh == loaded.mesh;
+        let opts = CheckOptions {
+            self_intersections: copts.self_intersections && !unchanged,
+            ..copts
+        };
+        let mut after = latvox::check::check(&written.mesh, written.normals.as_deref(), &opts)?;
+        if unchanged {
+            after.self_intersections = before.self_intersections;
+            after.self_intersection_examples = before.self_intersection_examples.clone();
+            after.valid_solid = after.defects().is_empty();
+        }
+        after
     };
     let normals_fixed = before
         .normals

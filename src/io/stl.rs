@@ -144,24 +144,25 @@ pub fn parse_facets(data: &[u8]) -> std::result::Result<Parsed, String> {
 }
 
 fn parse_binary(data: &[u8], n: usize) -> std::result::Result<Parsed, String> {
+    use rayon::prelude::*;
     if n == 0 {
         return Err("binary STL with zero facets".into());
     }
     // n is bounded by the file size here (checked by the caller).
-    let mut w = ExactWelder::new(n / 2 + 16);
-    w.mesh.indices.reserve(3 * n);
-    let mut normals = Vec::with_capacity(n);
     let f = |rec: &[u8], o: usize| f32::from_le_bytes([rec[o], rec[o + 1], rec[o + 2], rec[o + 3]]);
-    for (t, rec) in data[84..].chunks_exact(50).enumerate() {
-        normals.push([f(rec, 0), f(rec, 4), f(rec, 8)]);
-        for k in 0..3 {
-            let o = 12 + 12 * k;
-            w.corner([f(rec, o), f(rec, o + 4), f(rec, o + 8)])
-                .map_err(|e| format!("facet {}: {e}", t + 1))?;
-        }
-    }
+    let records = &data[84..];
+    let normals: Vec<[f32; 3]> = records
+        .par_chunks_exact(50)
+        .map(|r| [f(r, 0), f(r, 4), f(r, 8)])
+        .collect();
+    let corners: Vec<[f32; 3]> = records
+        .par_chunks_exact(50)
+        .flat_map_iter(|r| {
+            (0..3).map(move |k| [f(r, 12 + 12 * k), f(r, 16 + 12 * k), f(r, 20 + 12 * k)])
+        })
+        .collect();
     Ok(Parsed {
-        mesh: w.mesh,
+        mesh: super::weld::weld_corners(&corners)?,
         normals: Some(normals),
         ..Parsed::default()
     })

@@ -100,6 +100,69 @@ impl ExactWelder {
     }
 }
 
+/// Welds a triangle soup given corner by corner (three per facet), in parallel: corners are
+/// dealt to a fixed number of shards by hash, each shard welds its own with a hash map, and the
+/// shards' vertices are numbered one shard after another (deterministic, whatever the thread
+/// count). Non-finite coordinates are an error naming the facet.
+pub fn weld_corners(corners: &[[f32; 3]]) -> Result<Mesh, String> {
+    use rayon::prelude::*;
+    const SHARDS: usize = 8;
+    if let Some(i) = corners
+        .par_iter()
+        .position_first(|p| !p.iter().all(|v| v.is_finite()))
+    {
+        return Err(format!(
+            "facet {}: non-finite vertex coordinate {:?}",
+            i / 3 + 1,
+            corners[i]
+        ));
+    }
+    let keys: Vec<u128> = corners.par_iter().map(|&p| key(p)).collect();
+    let shard: Vec<u8> = keys
+        .par_iter()
+        .map(|&k| ((FastHash.hash_one(k) >> 40) % SHARDS as u64) as u8)
+        .collect();
+    let parts: Vec<(Vec<u32>, Vec<u32>)> = (0..SHARDS)
+        .into_par_iter()
+        .map(|s| {
+            let mut map: FastMap<u128, u32> =
+                HashMap::with_capacity_and_hasher(keys.len() / (2 * SHARDS) + 16, FastHash);
+            let mut ids = Vec::with_capacity(keys.len() / SHARDS + 16);
+            let mut firsts = Vec::new();
+            for (c, (&k, &sh)) in keys.iter().zip(&shard).enumerate() {
+                if sh as usize != s {
+                    continue;
+                }
+                let next = firsts.len() as u32;
+                let id = *map.entry(k).or_insert(next);
+                if id == next {
+                    firsts.push(c as u32);
+                }
+                ids.push(id);
+            }
+            (ids, firsts)
+        })
+        .collect();
+    let mut offset = [0u32; SHARDS + 1];
+    for s in 0..SHARDS {
+        offset[s + 1] = offset[s] + parts[s].1.len() as u32;
+    }
+    let mut cursor = [0usize; SHARDS];
+    let mut indices = Vec::with_capacity(corners.len());
+    for &sh in &shard {
+        let s = sh as usize;
+        indices.push(offset[s] + parts[s].0[cursor[s]]);
+        cursor[s] += 1;
+    }
+    let mut positions = Vec::with_capacity(3 * offset[SHARDS] as usize);
+    for (_, firsts) in &parts {
+        for &c in firsts {
+            positions.extend_from_slice(&corners[c as usize]);
+        }
+    }
+    Ok(Mesh { positions, indices })
+}
+
 /// Welds an indexed mesh whose vertex list may repeat positions (OBJ, OFF, PLY, 3MF): returns the
 /// mesh over distinct positions. Unreferenced vertices are kept (at their first occurrence).
 pub fn weld_indexed(positions: &[f32], indices: &[u32]) -> Result<Mesh, String> {
