@@ -525,7 +525,7 @@ pub fn check(
     let non_manifold_vertices = nm_vertex.iter().filter(|x| **x).count() as u64;
     let vertices = used.iter().filter(|x| **x).count() as u64;
 
-    let (_, non_orientable) = orientation(mesh, &topo, &shell_of, nshells);
+    let (flip, non_orientable) = orientation(mesh, &topo, &shell_of, nshells);
 
     // Per shell measures. Vertices counted with a last-seen marker (a vertex shared by shells
     // touching there counts in each).
@@ -640,7 +640,7 @@ pub fn check(
         let keep: Vec<u32> = (0..nf as u32)
             .filter(|&f| topo.active[f as usize] && !zero[f as usize] && !is_dup[f as usize])
             .collect();
-        let si = crate::repair::cgal::soup_self_intersections(mesh, &keep, 16)?;
+        let si = crate::repair::cgal::soup_self_intersections(mesh, &keep, Some(&flip), 16)?;
         (Some(si.0), si.1)
     } else {
         (None, Vec::new())

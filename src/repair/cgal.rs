@@ -7,14 +7,24 @@ use crate::mesh::Mesh;
 
 /// Counts intersecting pairs among the facets `keep` of `mesh` (which must have three distinct
 /// vertices each); returns the total and up to `limit` pairs as facet indices of `mesh`.
+/// `flip` (per facet of `mesh`), when given, reverses facets so neighbours agree: the answer does
+/// not depend on winding, but CGAL can then build its mesh directly instead of orienting a soup.
 pub fn soup_self_intersections(
     mesh: &Mesh,
     keep: &[u32],
+    flip: Option<&[bool]>,
     limit: usize,
 ) -> Result<(u64, Vec<(u32, u32)>)> {
     let indices: Vec<u32> = keep
         .iter()
-        .flat_map(|&f| mesh.indices[3 * f as usize..3 * f as usize + 3].to_vec())
+        .flat_map(|&f| {
+            let t = &mesh.indices[3 * f as usize..3 * f as usize + 3];
+            if flip.is_some_and(|fl| fl[f as usize]) {
+                [t[0], t[2], t[1]]
+            } else {
+                [t[0], t[1], t[2]]
+            }
+        })
         .collect();
     let r = ffi::cgal_soup_self_intersections(&mesh.positions, &indices, limit)
         .map_err(|e| Error::backend("CGAL self-intersection search", e))?;

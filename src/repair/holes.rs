@@ -46,6 +46,72 @@ fn is_planar(pts: &[Vec3]) -> bool {
     pts.iter().all(|p| dot(sub(*p, c), n).abs() <= tol)
 }
 
+/// Rings of facets around a curved hole handed to CGAL with it.
+const RINGS: usize = 3;
+
+/// The facets within `rings` vertex rings of the loops that start with the hole edges `curved`,
+/// as a mesh over its own vertices, and the global id of each of its vertices.
+fn neighbourhood(
+    mesh: &Mesh,
+    loops: &[BoundaryLoop],
+    curved: &[(u32, u32)],
+    rings: usize,
+) -> (Mesh, Vec<u32>) {
+    let nv = mesh.vertex_count();
+    let mut around: Vec<Vec<u32>> = vec![Vec::new(); nv];
+    for (f, t) in mesh.indices.chunks_exact(3).enumerate() {
+        for &v in t {
+            around[v as usize].push(f as u32);
+        }
+    }
+    let mut near = vec![false; nv];
+    let mut frontier: Vec<u32> = loops
+        .iter()
+        .filter(|l| curved.contains(&(l.vertices[0], l.vertices[1])))
+        .flat_map(|l| l.vertices.iter().copied())
+        .collect();
+    for &v in &frontier {
+        near[v as usize] = true;
+    }
+    let mut taken = vec![false; mesh.triangle_count()];
+    for _ in 0..rings {
+        let mut next = Vec::new();
+        for &v in &frontier {
+            for &f in &around[v as usize] {
+                if taken[f as usize] {
+                    continue;
+                }
+                taken[f as usize] = true;
+                for &w in &mesh.indices[3 * f as usize..3 * f as usize + 3] {
+                    if !near[w as usize] {
+                        near[w as usize] = true;
+                        next.push(w);
+                    }
+                }
+            }
+        }
+        frontier = next;
+    }
+    let mut local = vec![u32::MAX; nv];
+    let mut global = Vec::new();
+    let mut sub = Mesh::default();
+    for (f, t) in mesh.indices.chunks_exact(3).enumerate() {
+        if !taken[f] {
+            continue;
+        }
+        for &v in t {
+            if local[v as usize] == u32::MAX {
+                local[v as usize] = global.len() as u32;
+                global.push(v);
+                sub.positions
+                    .extend_from_slice(&mesh.positions[3 * v as usize..3 * v as usize + 3]);
+            }
+            sub.indices.push(local[v as usize]);
+        }
+    }
+    (sub, global)
+}
+
 /// Whether all vertices of the facets `members` lie in one plane (that of the largest facet).
 pub fn is_flat(mesh: &Mesh, members: &[u32]) -> bool {
     let Some(&big) = members.iter().max_by(|&&a, &&b| {
@@ -103,10 +169,30 @@ pub fn fill(mesh: &mut Mesh, loops: &[BoundaryLoop], fair: bool) -> Result<HoleS
     if curved.is_empty() {
         return Ok(stats);
     }
-    match cgal::fill_holes(mesh, &curved, fair) {
+    // CGAL gets only the facets near the holes (a few rings around each loop): refining and
+    // fairing look no farther, and a million-facet part need not be rebuilt as a Surface_mesh.
+    let (sub, global) = neighbourhood(mesh, loops, &curved, RINGS);
+    let local_of: std::collections::HashMap<u32, u32> = global
+        .iter()
+        .enumerate()
+        .map(|(l, &g)| (g, l as u32))
+        .collect();
+    let starts: Vec<(u32, u32)> = curved
+        .iter()
+        .map(|(a, b)| (local_of[a], local_of[b]))
+        .collect();
+    match cgal::fill_holes(&sub, &starts, fair) {
         Ok(f) => {
+            let first_new = mesh.vertex_count() as u32;
+            let nv_sub = sub.vertex_count() as u32;
             mesh.positions.extend_from_slice(&f.positions);
-            mesh.indices.extend_from_slice(&f.indices);
+            mesh.indices.extend(f.indices.iter().map(|&i| {
+                if i < nv_sub {
+                    global[i as usize]
+                } else {
+                    first_new + (i - nv_sub)
+                }
+            }));
             stats.facets_added += (f.indices.len() / 3) as u64;
             for (ok, faired) in f.filled.iter().zip(&f.faired) {
                 if *ok {
