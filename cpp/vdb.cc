@@ -10,9 +10,12 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
+#include <array>
+#include <atomic>
 #include <cmath>
 #include <mutex>
 #include <stdexcept>
+#include <string>
 
 #include "latvox/src/ffi/vdb.rs.h"
 
@@ -124,6 +127,90 @@ void vdb_volume_to_mesh(const VdbGrid& g, double adaptivity, rust::Vec<float>& p
       indices.push_back(q[3]); indices.push_back(q[2]); indices.push_back(q[1]);
     }
   }
+}
+
+void vdb_extract(const VdbGrid& g, Extraction& out) {
+  namespace vi = openvdb::tools::volume_to_mesh_internal;
+  // Mesh in index space: points then carry their voxel in their integer part. Sample values are
+  // kept at least 1/64 voxel from zero (grid.rs), so every edge crossing, and hence every point,
+  // lies at least 1/2304 voxel inside its voxel: far more than float rounding at these
+  // coordinates (|x| < 2^12), so floor() recovers the voxel exactly.
+  auto grid = g.impl->grid->copy();
+  grid->setTransform(openvdb::math::Transform::createLinearTransform(1.0));
+  openvdb::tools::VolumeToMesh mesher(0.0, 0.0, false);
+  mesher(*grid);
+  const std::size_t np = mesher.pointListSize();
+  const auto& pts = mesher.pointList();
+
+  out.voxels.reserve(3 * np);
+  out.groups.reserve(np);
+  out.offsets.reserve(3 * np);
+  for (std::size_t i = 0; i < np; ++i) {
+    const auto& p = pts[i];
+    if (!(std::fabs(p.x()) < 4096.f && std::fabs(p.y()) < 4096.f && std::fabs(p.z()) < 4096.f))
+      throw std::range_error("index-space point too far from the grid origin to decode");
+    for (int a = 0; a < 3; ++a) out.voxels.push_back(static_cast<int32_t>(std::floor(p[a])));
+    // Points of one voxel come out consecutively, one per edge group in group order.
+    const bool same = i > 0 && out.voxels[3 * i] == out.voxels[3 * i - 3] &&
+                      out.voxels[3 * i + 1] == out.voxels[3 * i - 2] &&
+                      out.voxels[3 * i + 2] == out.voxels[3 * i - 1];
+    out.groups.push_back(same ? static_cast<uint8_t>(out.groups[i - 1] + 1) : 0);
+    for (int a = 0; a < 3; ++a) out.offsets.push_back(0.0);
+  }
+
+  std::atomic<bool> mismatch{false};
+  std::mutex msg_mutex;
+  std::string msg;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, np),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+    auto acc = grid->getConstAccessor();
+    std::array<double, 8> values;
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const openvdb::Coord ijk(out.voxels[3 * i], out.voxels[3 * i + 1], out.voxels[3 * i + 2]);
+      vi::getCellVertexValues(acc, ijk, values);
+      uint8_t signs = vi::computeSignFlags(values, 0.0);
+      // As volumeToMesh does: an ambiguous face takes its neighbour's reading.
+      if (const uint8_t face = vi::sAmbiguousFace[signs])
+        vi::correctCellSigns(signs, face, acc, ijk, 0.0f);
+      const unsigned group = out.groups[i] + 1u;
+      if (group > vi::sEdgeGroupTable[signs][0]) {
+        std::lock_guard<std::mutex> lock(msg_mutex);
+        if (msg.empty())
+          msg = "point " + std::to_string(i) + " at (" + std::to_string(pts[i][0]) + ", " +
+                std::to_string(pts[i][1]) + ", " + std::to_string(pts[i][2]) + ") is group " +
+                std::to_string(group) + " of a voxel with " +
+                std::to_string(int(vi::sEdgeGroupTable[signs][0]));
+        mismatch = true;
+        continue;
+      }
+      const openvdb::Vec3d o = vi::computePoint(values, signs, static_cast<uint8_t>(group), 0.0);
+      // The recomputed point must be the one OpenVDB placed (up to float rounding).
+      for (int a = 0; a < 3; ++a) {
+        if (std::fabs(o[a] + ijk[a] - pts[i][a]) > 1e-3) {
+          std::lock_guard<std::mutex> lock(msg_mutex);
+          if (msg.empty())
+            msg = "point " + std::to_string(i) + " axis " + std::to_string(a) + " at " +
+                  std::to_string(pts[i][a]) + " recomputed as " + std::to_string(o[a] + ijk[a]);
+          mismatch = true;
+        }
+        out.offsets[3 * i + a] = o[a];
+      }
+    }
+  });
+  if (mismatch)
+    throw std::logic_error("a volumeToMesh point could not be matched to its voxel: " + msg);
+
+  std::size_t nq = 0;
+  const auto& pools = mesher.polygonPoolList();
+  for (std::size_t n = 0; n < mesher.polygonPoolListSize(); ++n) {
+    if (pools[n].numTriangles() != 0)
+      throw std::logic_error("volumeToMesh made triangles at adaptivity 0");
+    nq += pools[n].numQuads();
+  }
+  out.quads.reserve(4 * nq);
+  for (std::size_t n = 0; n < mesher.polygonPoolListSize(); ++n)
+    for (std::size_t q = 0; q < pools[n].numQuads(); ++q)
+      for (int k = 0; k < 4; ++k) out.quads.push_back(pools[n].quad(q)[k]);
 }
 
 uint64_t vdb_active_voxels(const VdbGrid& g) { return g.impl->grid->activeVoxelCount(); }

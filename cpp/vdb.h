@@ -22,8 +22,12 @@ std::unique_ptr<VdbGrid> vdb_grid_from_leaves(double voxel_size, rust::Slice<con
                                               rust::Slice<const int32_t> leaf_origins,
                                               rust::Slice<const float> values);
 
+struct Extraction;
+
 void vdb_volume_to_mesh(const VdbGrid& grid, double adaptivity, rust::Vec<float>& positions,
                         rust::Vec<uint32_t>& indices);
+
+void vdb_extract(const VdbGrid& grid, Extraction& out);
 
 uint64_t vdb_active_voxels(const VdbGrid& grid);
 uint64_t vdb_leaf_count(const VdbGrid& grid);

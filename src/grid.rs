@@ -12,6 +12,15 @@ use crate::field::{Aabb, Field, Vec3};
 use crate::mesh::Mesh;
 use rayon::prelude::*;
 
+/// Block `(bx, by, bz)` of a block range starting at `lo` with `n` blocks per axis.
+fn block_at(lo: [i64; 3], n: [usize; 3], idx: usize) -> [i64; 3] {
+    [
+        lo[0] + (idx / (n[1] * n[2])) as i64,
+        lo[1] + ((idx / n[2]) % n[1]) as i64,
+        lo[2] + (idx % n[2]) as i64,
+    ]
+}
+
 /// Where and how finely to sample: voxel `(i, j, k)` is the point `origin + (i + ½, j + ½, k + ½)·h`.
 #[derive(Debug, Clone, Copy)]
 pub struct GridSpec {
@@ -43,10 +52,39 @@ impl GridSpec {
     }
 }
 
+/// A box of sample indices, `lo` inclusive, `hi` exclusive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct IndexBox {
+    pub lo: [i64; 3],
+    pub hi: [i64; 3],
+}
+
+impl IndexBox {
+    pub fn contains(&self, i: [i64; 3]) -> bool {
+        (0..3).all(|a| i[a] >= self.lo[a] && i[a] < self.hi[a])
+    }
+
+    /// The box grown by `m` samples on every side.
+    pub fn grown(&self, m: i64) -> IndexBox {
+        IndexBox {
+            lo: self.lo.map(|x| x - m),
+            hi: self.hi.map(|x| x + m),
+        }
+    }
+}
+
+/// Sample values are kept at least this fraction of a voxel away from zero, so that no edge
+/// crossing falls on a sample and every extracted point lies strictly inside its voxel (see
+/// `extract`). The nudge is far below anything the mesh can show.
+pub const MIN_ABS_VALUE_VOXELS: f64 = 1.0 / 64.0;
+
 /// A sparse narrow-band level set held by OpenVDB.
 pub struct Grid {
     inner: cxx::UniquePtr<ffi::VdbGrid>,
     pub spec: GridSpec,
+    /// Global sample index of the OpenVDB grid's index (0, 0, 0). OpenVDB sees indices relative
+    /// to it, so its coordinates stay small however far the grid lies from the part's origin.
+    pub frame: [i64; 3],
     /// Leaf blocks that were tested, and that were sampled.
     pub blocks_tested: u64,
     pub blocks_sampled: u64,
@@ -60,60 +98,100 @@ pub fn set_backend_threads(n: usize) {
 impl Grid {
     /// Samples `field` on the narrow band of its zero set within the padded region of `spec`.
     pub fn sample(field: &dyn Field, spec: GridSpec) -> Result<Grid> {
+        let pad = spec.half_width.ceil() as i64 + 1;
+        let region = IndexBox {
+            lo: [-pad; 3],
+            hi: [0, 1, 2].map(|a| spec.dims[a] + pad),
+        };
+        Self::sample_box(field, spec, region)
+    }
+
+    /// Samples `field` on the narrow band within the leaf blocks that cover `region` (sample
+    /// indices of `spec`).
+    pub fn sample_box(field: &dyn Field, spec: GridSpec, region: IndexBox) -> Result<Grid> {
         let h = spec.voxel;
         let band = spec.half_width * h;
-        let pad = spec.half_width.ceil() as i64 + 1;
-        let lo = [(-pad).div_euclid(8); 3];
-        let hi = [0, 1, 2].map(|a| (spec.dims[a] + pad).div_euclid(8));
-        let n = [0, 1, 2].map(|a| (hi[a] - lo[a] + 1) as usize);
+        let lo = region.lo.map(|x| x.div_euclid(8));
+        let hi = region.hi.map(|x| (x - 1).div_euclid(8));
+        let n = [0, 1, 2].map(|a| (hi[a] - lo[a] + 1).max(0) as usize);
         let total = n[0] * n[1] * n[2];
+        let frame = lo.map(|b| b * 8);
         // Half diagonal of a block of 8 samples spaced h apart: from its centre to a corner sample.
         let reach = 3.5 * h * 3f64.sqrt() + band;
+        let bandf = band as f32;
+        let eps = (MIN_ABS_VALUE_VOXELS * h) as f32;
 
-        let blocks: Vec<([i32; 3], Box<[f32; 512]>)> = (0..total)
+        // Pass 1: which blocks can hold the band (cheap: one clearance per block).
+        let candidates: Vec<usize> = (0..total)
             .into_par_iter()
-            .filter_map(|idx| {
-                let b = [
-                    lo[0] + (idx / (n[1] * n[2])) as i64,
-                    lo[1] + ((idx / n[2]) % n[1]) as i64,
-                    lo[2] + (idx % n[2]) as i64,
-                ];
-                let first = [b[0] * 8, b[1] * 8, b[2] * 8];
-                let p0 = spec.point(first);
+            .filter(|&idx| {
+                let b = block_at(lo, n, idx);
+                let p0 = spec.point(b.map(|c| c * 8));
                 let centre = [0, 1, 2].map(|a| p0[a] + 3.5 * h);
-                if field.clearance(centre) > reach {
-                    return None;
-                }
-                let mut vals = Box::new([0.0f32; 512]);
-                field.sample_block(p0, h, &mut vals);
-                let bandf = band as f32;
+                field.clearance(centre) <= reach
+            })
+            .collect();
+        // Pass 2: sample them straight into one flat buffer, then drop blocks the band missed.
+        let mut values = vec![0.0f32; candidates.len() * 512];
+        let keep: Vec<bool> = values
+            .par_chunks_mut(512)
+            .zip(candidates.par_iter())
+            .map(|(vals, &idx)| {
+                let b = block_at(lo, n, idx);
+                let vals: &mut [f32; 512] = vals.try_into().expect("512 values per block");
+                field.sample_block(spec.point(b.map(|c| c * 8)), h, vals);
                 if !vals.iter().any(|v| v.abs() < bandf) {
-                    return None;
+                    return false;
                 }
                 for v in vals.iter_mut() {
                     *v = v.clamp(-bandf, bandf);
+                    if v.abs() < eps {
+                        *v = if *v < 0.0 { -eps } else { eps };
+                    }
                 }
-                Some((first.map(|c| c as i32), vals))
+                true
             })
             .collect();
-
-        let mut origins = Vec::with_capacity(blocks.len() * 3);
-        let mut values = Vec::with_capacity(blocks.len() * 512);
-        for (o, v) in &blocks {
-            origins.extend_from_slice(o);
-            values.extend_from_slice(&v[..]);
+        let mut origins = Vec::with_capacity(candidates.len() * 3);
+        let mut w = 0;
+        for (k, &idx) in candidates.iter().enumerate() {
+            if !keep[k] {
+                continue;
+            }
+            let b = block_at(lo, n, idx);
+            origins.extend((0..3).map(|a| (b[a] * 8 - frame[a]) as i32));
+            if w != k {
+                values.copy_within(k * 512..(k + 1) * 512, w * 512);
+            }
+            w += 1;
         }
-        let sampled = blocks.len() as u64;
-        drop(blocks);
+        values.truncate(w * 512);
+        let sampled = w as u64;
+        let grid_origin = spec.point(frame).map(|x| x - 0.5 * h);
         let inner =
-            ffi::vdb_grid_from_leaves(h, &spec.origin, spec.half_width as f32, &origins, &values)
+            ffi::vdb_grid_from_leaves(h, &grid_origin, spec.half_width as f32, &origins, &values)
                 .map_err(|e| Error::backend("building the OpenVDB grid", e))?;
         Ok(Grid {
             inner,
             spec,
+            frame,
             blocks_tested: total as u64,
             blocks_sampled: sampled,
         })
+    }
+
+    /// OpenVDB's volumeToMesh in index space, each point tied to its voxel and edge group, in
+    /// this grid's global sample indices.
+    pub(crate) fn extract(&self) -> Result<ffi::Extraction> {
+        let mut out = ffi::Extraction::default();
+        ffi::vdb_extract(&self.inner, &mut out)
+            .map_err(|e| Error::backend("meshing the level set (OpenVDB volumeToMesh)", e))?;
+        for v in out.voxels.chunks_exact_mut(3) {
+            for (x, f) in v.iter_mut().zip(self.frame) {
+                *x += f as i32;
+            }
+        }
+        Ok(out)
     }
 
     /// Meshes the zero level set with OpenVDB's volumeToMesh; triangles wound outward.

@@ -7,6 +7,7 @@
 
 pub mod check;
 pub mod error;
+pub mod extract;
 pub(crate) mod ffi;
 pub mod field;
 pub mod grid;

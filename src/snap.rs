@@ -16,9 +16,9 @@
 //! [`MAX_TURN_DEGREES`] is found and its vertices are returned to OpenVDB's positions, repeatedly,
 //! until none is.
 
+use crate::extract::{position, KeyedMesh};
 use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
-use crate::mesh::Mesh;
 use rayon::prelude::*;
 
 /// What the snap pass did, for the report.
@@ -34,6 +34,15 @@ pub struct SnapStats {
     pub restored: u64,
 }
 
+impl std::ops::AddAssign for SnapStats {
+    fn add_assign(&mut self, o: SnapStats) {
+        self.surface += o.surface;
+        self.edge += o.edge;
+        self.kept += o.kept;
+        self.restored += o.restored;
+    }
+}
+
 /// A triangle whose normal turns more than this in snapping is taken as folded.
 pub const MAX_TURN_DEGREES: f64 = 60.0;
 
@@ -44,19 +53,16 @@ enum Outcome {
     Untouched,
 }
 
-/// Snaps the vertices of `mesh`, meshed from `surface ∩ clip` sampled on `spec`.
-pub fn snap(mesh: &mut Mesh, surface: &dyn Field, clip: &Aabb, spec: &GridSpec) -> SnapStats {
-    let original = mesh.positions.clone();
+/// Snaps the vertices of `mesh`, extracted from `surface ∩ clip` sampled on `spec`.
+pub fn snap(mesh: &mut KeyedMesh, surface: &dyn Field, clip: &Aabb, spec: &GridSpec) -> SnapStats {
     let outcomes: Vec<Outcome> = mesh
         .positions
-        .par_chunks_exact_mut(3)
-        .map(|p| {
-            let v = [p[0] as f64, p[1] as f64, p[2] as f64];
-            let (out, w) = snap_vertex(v, surface, clip, spec);
+        .par_iter_mut()
+        .zip(mesh.keys.par_iter())
+        .map(|(p, k)| {
+            let (out, w) = snap_vertex(*p, k.voxel, surface, clip, spec);
             if let Some(w) = w {
-                p[0] = w[0] as f32;
-                p[1] = w[1] as f32;
-                p[2] = w[2] as f32;
+                *p = w;
             }
             out
         })
@@ -70,30 +76,34 @@ pub fn snap(mesh: &mut Mesh, surface: &dyn Field, clip: &Aabb, spec: &GridSpec) 
             Outcome::Untouched => {}
         }
     }
-    s.restored = unfold(mesh, &original);
+    mesh.triangulate();
+    s.restored = unfold(mesh, spec);
     s
 }
 
-/// Returns to `original` the vertices of triangles that snapping turned by more than
+/// Returns to OpenVDB's position the vertices of triangles that snapping turned by more than
 /// [`MAX_TURN_DEGREES`]; repeats until no triangle is turned. Returns how many were restored.
-pub fn unfold(mesh: &mut Mesh, original: &[f32]) -> u64 {
+pub fn unfold(mesh: &mut KeyedMesh, spec: &GridSpec) -> u64 {
     use crate::mesh::{cross, dot, norm, sub};
     let cos_max = MAX_TURN_DEGREES.to_radians().cos();
-    let at = |pos: &[f32], i: u32| {
-        let i = 3 * i as usize;
-        [pos[i] as f64, pos[i + 1] as f64, pos[i + 2] as f64]
+    let original = |m: &KeyedMesh, v: u32| {
+        let v = v as usize;
+        position(spec, m.keys[v].voxel, m.offsets[v])
     };
-    let normal = |pos: &[f32], t: &[u32]| {
-        let (a, b, c) = (at(pos, t[0]), at(pos, t[1]), at(pos, t[2]));
-        cross(sub(b, a), sub(c, a))
-    };
+    let normal = |a: Vec3, b: Vec3, c: Vec3| cross(sub(b, a), sub(c, a));
     let mut restored = 0u64;
     for _ in 0..8 {
-        let bad: Vec<u32> = mesh
-            .indices
-            .par_chunks_exact(3)
+        let m = &*mesh;
+        let bad: Vec<u32> = (0..m.quads.len())
+            .into_par_iter()
+            .flat_map_iter(|q| {
+                let (t, u) = m.quad_triangles(q);
+                std::iter::once(t).chain(u)
+            })
             .filter(|t| {
-                let (n1, n0) = (normal(&mesh.positions, t), normal(original, t));
+                let p = t.map(|v| m.positions[v as usize]);
+                let o = t.map(|v| original(m, v));
+                let (n1, n0) = (normal(p[0], p[1], p[2]), normal(o[0], o[1], o[2]));
                 let (l1, l0) = (norm(n1), norm(n0));
                 l0 > 0.0 && (l1 == 0.0 || dot(n1, n0) < cos_max * l1 * l0)
             })
@@ -101,9 +111,10 @@ pub fn unfold(mesh: &mut Mesh, original: &[f32]) -> u64 {
             .collect();
         let mut changed = false;
         for v in bad {
-            let i = 3 * v as usize;
-            if mesh.positions[i..i + 3] != original[i..i + 3] {
-                mesh.positions[i..i + 3].copy_from_slice(&original[i..i + 3]);
+            let o = original(mesh, v);
+            let p = &mut mesh.positions[v as usize];
+            if *p != o {
+                *p = o;
                 restored += 1;
                 changed = true;
             }
@@ -117,14 +128,14 @@ pub fn unfold(mesh: &mut Mesh, original: &[f32]) -> u64 {
 
 fn snap_vertex(
     v: Vec3,
+    voxel: [i32; 3],
     surface: &dyn Field,
     clip: &Aabb,
     spec: &GridSpec,
 ) -> (Outcome, Option<Vec3>) {
     let h = spec.voxel;
-    // The dual cell holding v spans samples c..c+1 on each axis.
-    let c = [0, 1, 2].map(|a| ((v[a] - spec.origin[a]) / h - 0.5).floor());
-    let lo = [0, 1, 2].map(|a| spec.origin[a] + (c[a] + 0.5) * h);
+    // The voxel holding v spans samples voxel..voxel+1 on each axis.
+    let lo = [0, 1, 2].map(|a| spec.origin[a] + (voxel[a] as f64 + 0.5) * h);
     // A moved vertex must stay in its cell (no fold-over) and in the clip box (the part's bounds).
     let inside = |w: Vec3| {
         (0..3).all(|a| {

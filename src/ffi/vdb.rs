@@ -2,6 +2,20 @@
 
 #[cxx::bridge(namespace = "latvox")]
 pub(crate) mod ffi {
+    /// volumeToMesh's output in index space, with each point's voxel and edge group recovered.
+    #[derive(Default)]
+    struct Extraction {
+        /// Lower-corner sample of each point's voxel, xyz triples, in the grid's index frame.
+        voxels: Vec<i32>,
+        /// Edge group of each point within its voxel (OpenVDB's group numbering, from 0).
+        groups: Vec<u8>,
+        /// Each point within its voxel, in [0, 1]³: OpenVDB's average of the group's edge
+        /// crossings, recomputed from the voxel's corner values in double precision.
+        offsets: Vec<f64>,
+        /// Quads as OpenVDB winds them (inward), four point indices each.
+        quads: Vec<u32>,
+    }
+
     unsafe extern "C++" {
         include!("latvox/cpp/vdb.h");
 
@@ -21,6 +35,7 @@ pub(crate) mod ffi {
             positions: &mut Vec<f32>,
             indices: &mut Vec<u32>,
         ) -> Result<()>;
+        fn vdb_extract(grid: &VdbGrid, out: &mut Extraction) -> Result<()>;
         fn vdb_active_voxels(grid: &VdbGrid) -> u64;
         fn vdb_leaf_count(grid: &VdbGrid) -> u64;
         fn vdb_memory_bytes(grid: &VdbGrid) -> u64;

@@ -17,6 +17,7 @@ pub use job::{TpmsJob, TpmsReport};
 pub use surface::{Structure, Surface, TpmsField};
 
 use crate::error::{Error, Result};
+use crate::extract::KeyedMesh;
 use crate::field::{Aabb, Intersection, Vec3};
 use crate::grid::{Grid, GridSpec};
 use crate::mesh::Mesh;
@@ -75,6 +76,16 @@ impl Lattice {
     }
 
     pub(crate) fn mesh_on(&self, spec: GridSpec, adaptivity: f64) -> Result<(Mesh, MeshingStats)> {
+        let (keyed, stats) = self.mesh_keyed(spec, adaptivity)?;
+        Ok((keyed.to_mesh(), stats))
+    }
+
+    /// Samples, meshes and snaps the lattice on `spec`, keeping each vertex's key.
+    pub(crate) fn mesh_keyed(
+        &self,
+        spec: GridSpec,
+        adaptivity: f64,
+    ) -> Result<(KeyedMesh, MeshingStats)> {
         use std::time::Instant;
         let tpms = self.field(spec.half_width * spec.voxel);
         let solid = Intersection {
@@ -85,7 +96,11 @@ impl Lattice {
         let grid = Grid::sample(&solid, spec)?;
         let sample_seconds = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let mut mesh = grid.to_mesh(adaptivity)?;
+        let mut keyed = if adaptivity == 0.0 {
+            KeyedMesh::extract(&grid)?
+        } else {
+            KeyedMesh::from_adaptive(&grid.to_mesh(adaptivity)?, &spec)
+        };
         let mesh_seconds = t.elapsed().as_secs_f64();
         let stats = MeshingStats {
             voxel_size: spec.voxel,
@@ -99,9 +114,9 @@ impl Lattice {
         };
         drop(grid);
         let t = Instant::now();
-        let snap_stats = snap(&mut mesh, &tpms, &self.bounds, &spec);
+        let snap_stats = snap(&mut keyed, &tpms, &self.bounds, &spec);
         Ok((
-            mesh,
+            keyed,
             MeshingStats {
                 snap: snap_stats,
                 snap_seconds: t.elapsed().as_secs_f64(),
