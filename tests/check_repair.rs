@@ -245,6 +245,38 @@ fn cgal_data_meshes_repair_into_sound_solids() {
     assert!(vol > 0.0);
 }
 
+/// Valid closed meshes from CGAL's archive (genus 0, 1 and 3): check passes, the genus agrees with
+/// trimesh's Euler number, and repair writes the very same facets back.
+#[test]
+fn valid_meshes_pass_and_repair_leaves_them_unchanged() {
+    let data = cgal_data();
+    let dir = tempdir();
+    for name in ["elephant", "knot1", "sphere966"] {
+        let file = data.join(format!("{name}.off"));
+        let (code, v) = check_json(&file, &[]);
+        assert_eq!(code, 0, "{name}: {v:#}");
+        let t = trimesh(&file);
+        let genus = (2 - t["euler"].as_i64().unwrap()) / 2;
+        assert_eq!(
+            v["check"]["shells"][0]["genus"].as_i64().unwrap(),
+            genus,
+            "{name}"
+        );
+        assert_eq!(u(&t["bodies"]), 1, "{name}");
+        let out = dir.path().join(format!("{name}.stl"));
+        let (code, r) = repair_json(&file, &out, &[]);
+        assert_eq!(code, 0, "{name}");
+        assert!(
+            r["repair"]["changes"].as_array().unwrap().is_empty(),
+            "{name}: {r:#}"
+        );
+        let key = |t: &Tri| t.map(|p| p.map(|x| (x as f32).to_bits()));
+        let before: Vec<_> = read_off(&file).iter().map(key).collect();
+        let after: Vec<_> = common::read_stl(&out).iter().map(key).collect();
+        assert_eq!(before, after, "{name}: same facets in the same order");
+    }
+}
+
 /// admesh's example block: a valid closed solid in upper-case ASCII STL. latvox agrees with
 /// admesh on facet count and volume, and repair hands it back unchanged.
 #[test]

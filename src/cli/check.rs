@@ -80,7 +80,13 @@ pub fn run(a: &CheckArgs, quiet: bool) -> Result<i32> {
     // degenerate nor duplicate); it is not run twice.
     cgal.self_intersection_checked = report.self_intersections.is_some();
     cgal.self_intersecting = report.self_intersections.unwrap_or(0) > 0;
-    let edges = mesh.edge_stats();
+    // The edge counts of the first `check` (kept for scripts that read them).
+    let edges = latvox::mesh::EdgeStats {
+        edges: report.edges,
+        boundary: report.boundary_edges,
+        non_manifold: report.non_manifold_edges,
+        misoriented: report.inconsistent_edges,
+    };
     let ok = report.valid_solid
         && cgal.manifold
         && cgal.closed

@@ -117,24 +117,23 @@ pub fn weld_corners(corners: &[[f32; 3]]) -> Result<Mesh, String> {
             corners[i]
         ));
     }
-    let keys: Vec<u128> = corners.par_iter().map(|&p| key(p)).collect();
-    let shard: Vec<u8> = keys
+    let shard: Vec<u8> = corners
         .par_iter()
-        .map(|&k| ((FastHash.hash_one(k) >> 40) % SHARDS as u64) as u8)
+        .map(|&p| ((FastHash.hash_one(key(p)) >> 40) % SHARDS as u64) as u8)
         .collect();
     let parts: Vec<(Vec<u32>, Vec<u32>)> = (0..SHARDS)
         .into_par_iter()
         .map(|s| {
             let mut map: FastMap<u128, u32> =
-                HashMap::with_capacity_and_hasher(keys.len() / (2 * SHARDS) + 16, FastHash);
-            let mut ids = Vec::with_capacity(keys.len() / SHARDS + 16);
+                HashMap::with_capacity_and_hasher(corners.len() / (2 * SHARDS) + 16, FastHash);
+            let mut ids = Vec::with_capacity(corners.len() / SHARDS + 16);
             let mut firsts = Vec::new();
-            for (c, (&k, &sh)) in keys.iter().zip(&shard).enumerate() {
+            for (c, &sh) in shard.iter().enumerate() {
                 if sh as usize != s {
                     continue;
                 }
                 let next = firsts.len() as u32;
-                let id = *map.entry(k).or_insert(next);
+                let id = *map.entry(key(corners[c])).or_insert(next);
                 if id == next {
                     firsts.push(c as u32);
                 }
