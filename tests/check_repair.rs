@@ -603,6 +603,12 @@ fn ascii_stl_variants_are_read() {
     text += "ENDSOLID\r\n\r\nsome trailing text the exporter added\r\n";
     let f = dir.path().join("variants.stl");
     std::fs::write(&f, &text).unwrap();
+    // A Latin-1 solid name (not UTF-8) is only a name.
+    let mut latin1 = b"solid W\xfcrfel\n".to_vec();
+    latin1.extend_from_slice(text.split_once('\n').unwrap().1.as_bytes());
+    std::fs::write(dir.path().join("latin1.stl"), &latin1).unwrap();
+    let (_, v) = check_json(&dir.path().join("latin1.stl"), &[]);
+    assert_eq!(u(&v["check"]["facets"]), 12);
     let (code, v) = check_json(&f, &[]);
     assert_eq!(u(&v["check"]["facets"]), 12, "{v:#}");
     assert_eq!(u(&v["check"]["boundary_edges"]), 0);
@@ -673,6 +679,7 @@ fn malformed_files_fail_cleanly() {
         }),
         ("bad-index.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n".to_vec()),
         ("not-a-zip.3mf", b"PK\x03\x04 this is not really a zip".to_vec()),
+        ("all-degenerate.stl", b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\nendsolid\n".to_vec()),
     ];
     for (name, bytes) in cases {
         let f = dir.path().join(name);
@@ -688,6 +695,11 @@ fn malformed_files_fail_cleanly() {
                 )
             };
             let err = String::from_utf8_lossy(&out.stderr);
+            if cmd == "check" && name == "all-degenerate.stl" {
+                // Readable, and wholly defective.
+                assert_eq!(out.status.code(), Some(1), "{cmd} {name}: {err}");
+                continue;
+            }
             assert_eq!(out.status.code(), Some(2), "{cmd} {name}: {err}");
             assert_eq!(err.trim().lines().count(), 1, "{cmd} {name}: {err}");
             assert!(err.starts_with("latvox: "), "{cmd} {name}: {err}");

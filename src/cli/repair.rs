@@ -88,6 +88,17 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
         remesh: a.remesh,
     };
     let (mesh, changes) = latvox::repair::repair(&loaded.mesh, &ropts, &progress)?;
+    if mesh.triangle_count() == 0 {
+        return Err(latvox::Error::invalid(format!(
+            "{}: nothing is left after repair (every facet was degenerate{}); no file written",
+            a.input.display(),
+            if a.drop_open_shells {
+                " or in an open shell"
+            } else {
+                ""
+            }
+        )));
+    }
     {
         let _s = progress.stage("writing");
         latvox::io::save(&mesh, &a.output, a.ascii)?;
