@@ -24,6 +24,7 @@ A valid mesh comes back unchanged. Shells that stay open are reported, and only 
 manifold and free of self-intersections at that resolution (details below a voxel are lost).
 
 The output format follows the extension of -o (.stl .obj .off .ply .3mf).
+Self-intersections are counted on the result only (repair does not mend them; --remesh does).
 Exit code 0 when the result is a valid closed solid, 1 when defects remain (the repaired file is
 still written), 2 on bad input or arguments (nothing written).";
 
@@ -76,9 +77,15 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
         self_intersections: !a.common.no_self_intersection,
         tolerance: a.common.weld_tolerance,
     };
+    // CGAL's self-intersection test (the costliest check) runs once, on the result: repair does
+    // not mend self-intersections, so the count before would only repeat it.
     let before = {
         let _s = progress.stage("checking the input");
-        latvox::check::check(&loaded.mesh, loaded.normals.as_deref(), &copts)?
+        let opts = CheckOptions {
+            self_intersections: false,
+            ..copts
+        };
+        latvox::check::check(&loaded.mesh, loaded.normals.as_deref(), &opts)?
     };
     let ropts = RepairOptions {
         fill_holes: !a.no_fill,
@@ -108,19 +115,7 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
     let after = {
         let _s = progress.stage("checking the written file");
         let written = load(&a.output, 0.0)?;
-        // Unchanged geometry keeps its self-intersection count: CGAL's test is not run again.
-        let unchanged = mesh == loaded.mesh;
-        let opts = CheckOptions {
-            self_intersections: copts.self_intersections && !unchanged,
-            ..copts
-        };
-        let mut after = latvox::check::check(&written.mesh, written.normals.as_deref(), &opts)?;
-        if unchanged {
-            after.self_intersections = before.self_intersections;
-            after.self_intersection_examples = before.self_intersection_examples.clone();
-            after.valid_solid = after.defects().is_empty();
-        }
-        after
+        latvox::check::check(&written.mesh, written.normals.as_deref(), &copts)?
     };
     let normals_fixed = before
         .normals
@@ -143,10 +138,13 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
         print_header(&a.input, &loaded);
         let d = before.defects();
         if d.is_empty() {
-            println!("before    no defects");
+            println!("before    no defects (self-intersections are checked on the result)");
         } else {
             let list: Vec<String> = d.iter().map(|(k, n)| format!("{n} {k}")).collect();
-            println!("before    {}", list.join(", "));
+            println!(
+                "before    {} (self-intersections are checked on the result)",
+                list.join(", ")
+            );
         }
         if changes.changes.is_empty() && normals_fixed == 0 {
             println!("changes   none (the mesh is written unchanged)");
