@@ -8,7 +8,7 @@
 //! 3. The whole `latvox repair` command on the damaged copy (read, check, repair, write, read the
 //!    written file back and check it again), as a user runs it.
 //!
-//! Medians of several runs. Run: `cargo bench --bench check` (add `-- --runs N`).
+//! Medians of several runs, wall time and (in-process) CPU time of all threads. Run: `cargo bench --bench check` (add `-- --runs N`).
 
 use latvox::check::{check, CheckOptions};
 use latvox::io::{ReadOptions, StlFormat};
@@ -23,15 +23,37 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// CPU seconds (user + system) used by this process so far, all threads.
+fn cpu_seconds() -> f64 {
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: getrusage fills the struct we own.
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+    let tv = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    tv(u.ru_utime) + tv(u.ru_stime)
+}
+
+thread_local! {
+    /// Median CPU seconds of the last `time` call (the machine is shared: wall time alone varies
+    /// with the load from other work, CPU time much less).
+    static LAST_CPU: std::cell::Cell<f64> = const { std::cell::Cell::new(0.0) };
+}
+
 fn time<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     let mut times = Vec::new();
+    let mut cpu = Vec::new();
     let mut last = None;
     for _ in 0..runs {
-        let t = Instant::now();
+        let (t, c) = (Instant::now(), cpu_seconds());
         last = Some(f());
         times.push(t.elapsed().as_secs_f64());
+        cpu.push(cpu_seconds() - c);
     }
+    LAST_CPU.with(|l| l.set(median(cpu)));
     (median(times), last.expect("at least one run"))
+}
+
+fn cpu() -> f64 {
+    LAST_CPU.with(|l| l.get())
 }
 
 /// A torus (R = 40 mm, r = 15 mm) of `nu × nv` quads, wound outward.
@@ -111,7 +133,8 @@ fn main() {
         latvox::io::read(&clean_path, &ReadOptions::default()).unwrap()
     });
     println!(
-        "  latvox read (parse + exact weld)     {t_read:.3} s   ({} vertices)",
+        "  latvox read (parse + exact weld)     {t_read:.3} s   (CPU {:.3} s; {} vertices)",
+        cpu(),
         loaded.mesh.vertex_count()
     );
     let admesh = |flags: &[&str]| {
@@ -143,6 +166,7 @@ fn main() {
         let (t_check, rep) = time(runs, || {
             check(mesh, None, &CheckOptions::default()).unwrap()
         });
+        let c_check = cpu();
         let (t_fast, _) = time(runs, || {
             check(
                 mesh,
@@ -154,9 +178,11 @@ fn main() {
             )
             .unwrap()
         });
+        let c_fast = cpu();
         let (t_repair, (fixed, report)) = time(runs, || {
             repair(mesh, &RepairOptions::default(), &progress).unwrap()
         });
+        let c_repair = cpu();
         let after = check(&fixed, None, &CheckOptions::default()).unwrap();
         println!(
             "  {label:8} check {t_check:.3} s (without self-intersections {t_fast:.3} s)  repair {t_repair:.3} s",
@@ -165,6 +191,9 @@ fn main() {
             "           check + repair {:.3} s; without the self-intersection test {:.3} s",
             t_check + t_repair,
             t_fast + t_repair
+        );
+        println!(
+            "           CPU: check {c_check:.3} s, without self-intersections {c_fast:.3} s, repair {c_repair:.3} s",
         );
         println!(
             "           defects before: {:?}; changes: {}; valid after: {}",
