@@ -383,8 +383,11 @@ pub fn winding_number(mesh: &Mesh, facets: &[u32], p: Vec3) -> f64 {
     omega / (4.0 * std::f64::consts::PI)
 }
 
-/// Nesting depth of each closed shell: how many other closed shells contain a point just inside
-/// it. `closed[s]` selects the shells taken into account; others get `None`.
+/// Probe points per shell for nesting.
+const PROBES: usize = 16;
+
+/// Nesting depth of each closed shell: how many other closed shells contain it (its bounding
+/// box, and every one of up to [`PROBES`] points spread over its surface). `closed[s]` selects the shells taken into account; others get `None`.
 pub fn nesting(mesh: &Mesh, members: &[Vec<u32>], closed: &[bool]) -> Vec<Option<u32>> {
     let bounds: Vec<Option<(Vec3, Vec3)>> = members
         .iter()
@@ -407,21 +410,29 @@ pub fn nesting(mesh: &Mesh, members: &[Vec<u32>], closed: &[bool]) -> Vec<Option
             if !closed[s] {
                 return None;
             }
-            // Probe: the centroid of the shell's largest facet.
-            let f = *members[s].iter().max_by(|&&a, &&b| {
-                let (na, _) = facet_normal(mesh, a as usize);
-                let (nb, _) = facet_normal(mesh, b as usize);
-                dot(na, na).total_cmp(&dot(nb, nb))
-            })?;
-            let [a, b, c] = mesh.triangle(f as usize);
-            let p = [0, 1, 2].map(|i| (a[i] + b[i] + c[i]) / 3.0);
+            // Probes: centroids of facets spread over the shell. A shell counts as inside
+            // another only if every probe is: shells that cross each other are not nested.
+            let fs = &members[s];
+            let stride = fs.len().div_ceil(PROBES).max(1);
+            let probes: Vec<Vec3> = fs
+                .iter()
+                .step_by(stride)
+                .map(|&f| {
+                    let [a, b, c] = mesh.triangle(f as usize);
+                    [0, 1, 2].map(|i| (a[i] + b[i] + c[i]) / 3.0)
+                })
+                .collect();
+            let (slo, shi) = bounds[s]?;
             let mut depth = 0;
             for (o, bo) in bounds.iter().enumerate() {
                 let Some((lo, hi)) = bo else { continue };
-                if o == s || !closed[o] || (0..3).any(|i| p[i] < lo[i] || p[i] > hi[i]) {
+                if o == s || !closed[o] || (0..3).any(|i| slo[i] < lo[i] || shi[i] > hi[i]) {
                     continue;
                 }
-                if winding_number(mesh, &members[o], p).abs() > 0.5 {
+                if probes
+                    .iter()
+                    .all(|&p| winding_number(mesh, &members[o], p).abs() > 0.5)
+                {
                     depth += 1;
                 }
             }

@@ -194,6 +194,51 @@ fn cgal_data_meshes_are_counted_like_trimesh_and_brute_force() {
     let (_, v) = check_json(&data.join("mannequin-devil.off"), &[]);
     assert!(u(&v["check"]["self_intersections"]) > 100, "{v}");
     assert_eq!(v["cgal"]["self_intersecting"], true);
+
+    // A binary STL with everything at once (holes, pinched vertices, wrong stored normals,
+    // self-intersections): counts as brute force and trimesh; stored normals recounted here.
+    let pig = data.join("pig.stl");
+    let (code, v) = check_json(&pig, &[]);
+    assert_eq!(code, 1);
+    let tris = common::read_stl(&pig);
+    assert_counts_agree("pig", &v["check"], &tris, &pig);
+    let bytes = std::fs::read(&pig).unwrap();
+    let (mut reversed, mut inaccurate) = (0, 0);
+    for (i, t) in tris.iter().enumerate() {
+        let r = &bytes[84 + 50 * i..];
+        let n: Vec<f64> = (0..3)
+            .map(|k| f32::from_le_bytes(r[4 * k..4 * k + 4].try_into().unwrap()) as f64)
+            .collect();
+        let m = cross3(t);
+        let (ln, lm) = (
+            (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt(),
+            (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt(),
+        );
+        if ln == 0.0 || lm == 0.0 {
+            continue;
+        }
+        let cos = (n[0] * m[0] + n[1] * m[1] + n[2] * m[2]) / (ln * lm);
+        if cos < 0.0 {
+            reversed += 1;
+        } else if cos < 5f64.to_radians().cos() {
+            inaccurate += 1;
+        }
+    }
+    assert_eq!(u(&v["check"]["normals"]["reversed"]), reversed);
+    assert_eq!(u(&v["check"]["normals"]["inaccurate"]), inaccurate);
+
+    // PLY files from the archive: the reader agrees with trimesh.
+    for name in ["sphere.ply", "colored_tetra.ply"] {
+        let file = data.join(name);
+        let (code, v) = check_json(&file, &[]);
+        assert_eq!(code, 0, "{name}: {v:#}");
+        let t = trimesh(&file);
+        let c = &v["check"];
+        assert_eq!(u(&c["facets"]), u(&t["faces"]), "{name}");
+        assert_eq!(u(&c["edges"]), u(&t["edges_unique"]), "{name}");
+        assert_eq!(u(&c["vertices"]), u(&t["vertices"]), "{name}");
+        assert!((c["volume"].as_f64().unwrap() - t["volume"].as_f64().unwrap()).abs() < 1e-6);
+    }
 }
 
 /// Repair of CGAL's broken meshes: every repairable one comes out closed, consistently wound,
@@ -229,6 +274,16 @@ fn cgal_data_meshes_repair_into_sound_solids() {
             );
         }
     }
+    // The pig: repaired into outward shells; remeshed into one clean solid.
+    let out = dir.path().join("pig.stl");
+    let (code, v) = repair_json(&data.join("pig.stl"), &out, &[]);
+    assert_eq!(code, 1, "self-intersections remain without --remesh");
+    assert_eq!(u(&v["after"]["boundary_edges"]), 0);
+    assert_eq!(u(&v["after"]["inward_shells"]), 0);
+    let (code, _) = repair_json(&data.join("pig.stl"), &out, &["--remesh", "0.5"]);
+    assert_eq!(code, 0);
+    assert_sound("pig", &out);
+
     // Self-intersecting: remesh.
     let out = dir.path().join("mannequin.stl");
     let (code, v) = repair_json(
