@@ -50,6 +50,20 @@ fn main() {
         .file("cpp/cgal.cc")
         .compile("latvox_cgal");
 
+    let mut cgal_repair = cxx_build::bridge("src/ffi/cgal_repair.rs");
+    flags(&mut cgal_repair);
+    cgal_repair
+        .define("CGAL_LINKED_WITH_TBB", None)
+        .define("CGAL_EIGEN3_ENABLED", None)
+        .file("cpp/cgal_repair.cc")
+        .compile("latvox_cgal_repair");
+
+    let mut vdb_remesh = cxx_build::bridge("src/ffi/vdb_remesh.rs");
+    flags(&mut vdb_remesh);
+    vdb_remesh
+        .file("cpp/vdb_remesh.cc")
+        .compile("latvox_vdb_remesh");
+
     for lib in ["openvdb", "tbb", "Imath-3_1", "gmp", "mpfr"] {
         println!("cargo:rustc-link-lib={lib}");
     }
@@ -63,6 +77,12 @@ fn main() {
         "src/ffi/vdb_filter.rs",
         "cpp/vdb_filter.h",
         "cpp/vdb_filter.cc",
+        "src/ffi/cgal_repair.rs",
+        "cpp/cgal_repair.h",
+        "cpp/cgal_repair.cc",
+        "src/ffi/vdb_remesh.rs",
+        "cpp/vdb_remesh.h",
+        "cpp/vdb_remesh.cc",
     ] {
         println!("cargo:rerun-if-changed={f}");
     }

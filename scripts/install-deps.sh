@@ -15,6 +15,8 @@ PKGS=(
   libxfixes3 libxext6 libxft2 libfontconfig1 libxinerama1 libx11-6 libgomp1
   # tests: a one-node Slurm cluster for latvox batch (scripts/slurm-test.sh)
   slurm-wlm munge
+  # mesh check/repair tests: CGAL's data archive of broken meshes; pip for trimesh
+  libcgal-demo python3-pip
 )
 
 if [ "$(id -u)" -eq 0 ]; then SUDO=(); else SUDO=(sudo); fi
@@ -47,4 +49,19 @@ else
     pip_install --user 2>/dev/null || pip_install --user --break-system-packages
   fi
   python3 -c "import numpy, scipy, gmsh, ezdxf"
+# Mesh check/repair tests: trimesh (PyPI) as an independent mesh analyser.
+if ! python3 -c "import trimesh, networkx, lxml" 2>/dev/null; then
+  echo "install-deps: installing trimesh (PyPI)" >&2
+  python3 -m pip install --quiet --disable-pip-version-check trimesh networkx lxml numpy \
+    || python3 -m pip install --quiet --disable-pip-version-check --break-system-packages trimesh networkx lxml numpy
+fi
+
+# Fuzzing the mesh readers inside `cargo test`: cargo-fuzz on a nightly toolchain.
+if command -v rustup >/dev/null 2>&1 && ! rustup toolchain list | grep -q '^nightly'; then
+  echo "install-deps: installing the nightly Rust toolchain (for cargo fuzz)" >&2
+  rustup toolchain install nightly --profile minimal
+fi
+if ! command -v cargo-fuzz >/dev/null 2>&1 && [ ! -x "${CARGO_HOME:-$HOME/.cargo}/bin/cargo-fuzz" ]; then
+  echo "install-deps: installing cargo-fuzz" >&2
+  cargo install --locked cargo-fuzz
 fi

@@ -2,27 +2,32 @@
 //! printable, verified meshes. Rust samples fields and orchestrates; OpenVDB holds the sparse
 //! level sets and meshes them; CGAL verifies the result.
 //!
-//! Stages, one module each: [`field`] → [`grid`] → [`mesh`] → [`verify`] → [`stl`] (output).
-//! Capabilities: [`tpms`], [`topopt`] (SIMP optimiser), [`topo`] (density fields to STL and CAD),
-//! [`cad`] (B-spline curves, IGES, DXF), [`batch`] (many jobs, resumable, sharded over Slurm
-//! arrays).
+//! Stages, one module each: [`field`] → [`grid`] → [`extract`] → [`mesh`] → [`verify`] →
+//! [`io`] / [`sink`] (files).
+//! Capabilities: [`tpms`], [`check`] and [`repair`] (any mesh file, seed 001's defects),
+//! [`topopt`] (SIMP optimiser), [`topo`] (density fields to STL and CAD), [`cad`] (B-spline
+//! curves, IGES, DXF), [`batch`] (many jobs, resumable, sharded over Slurm arrays).
 
 pub mod batch;
 pub mod cad;
+pub mod check;
 pub mod error;
 pub mod extract;
 pub(crate) mod ffi;
 pub mod field;
 pub mod grid;
+pub mod io;
 pub mod mesh;
 pub mod output;
 pub mod progress;
+pub mod repair;
 pub mod sink;
 pub mod snap;
-pub mod stl;
 pub mod topo;
+pub mod topology;
 pub mod topopt;
 pub mod tpms;
+pub mod triangulate;
 pub mod verify;
 
 pub use error::{Error, Result};

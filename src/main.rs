@@ -29,9 +29,13 @@ enum Command {
     /// Generate a closed TPMS lattice at an exact volume fraction.
     #[command(after_help = cli::tpms::EXAMPLES)]
     Tpms(cli::tpms::TpmsArgs),
-    /// Check an STL with CGAL: closed, outward, self-intersections, volume, area.
+    /// Check a mesh file: every defect counted (holes, non-manifold, winding, normals, degenerate
+    /// and duplicate facets, T-junctions, self-intersections), per shell too.
     #[command(after_help = cli::check::EXAMPLES)]
     Check(cli::check::CheckArgs),
+    /// Repair a mesh file and report every change by kind and count.
+    #[command(after_help = cli::repair::EXAMPLES)]
+    Repair(cli::repair::RepairArgs),
     /// SIMP topology optimisation (88-line code in 2D, top3d in 3D): densities to .npy.
     #[command(after_help = cli::topopt::EXAMPLES)]
     Topopt(cli::topopt::TopoptArgs),
@@ -83,7 +87,8 @@ fn main() {
     }
     let result = match &cli.command {
         Command::Tpms(a) => cli::tpms::run(a, cli.quiet),
-        Command::Check(a) => cli::check::run(a),
+        Command::Check(a) => cli::check::run(a, cli.quiet),
+        Command::Repair(a) => cli::repair::run(a, cli.quiet),
         Command::Topopt(a) => cli::topopt::run(a, cli.quiet),
         Command::Topo(a) => cli::topo::run(a, cli.quiet),
         Command::Batch(a) => cli::batch::run(a, cli.quiet),

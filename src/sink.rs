@@ -10,8 +10,8 @@
 
 use crate::error::{Error, Result};
 use crate::field::Aabb;
+use crate::io::stl::StlFormat;
 use crate::mesh::Mesh;
-use crate::stl::StlFormat;
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::io::Write;

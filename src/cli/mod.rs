@@ -3,6 +3,7 @@
 
 pub mod batch;
 pub mod check;
+pub mod repair;
 pub mod topo;
 pub mod topopt;
 pub mod tpms;
@@ -30,6 +31,24 @@ pub(crate) fn split3<T: Copy>(
 pub(crate) fn parse_f64(s: &str) -> std::result::Result<f64, String> {
     s.parse::<f64>()
         .map_err(|_| format!("'{s}' is not a number"))
+}
+
+pub(crate) fn parse_positive(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v > 0.0 && v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{s} must be a positive length in mm"))
+    }
+}
+
+pub(crate) fn parse_length0(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v >= 0.0 && v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{s} must be a length ≥ 0 mm"))
+    }
 }
 
 pub(crate) fn parse_positive3(s: &str) -> std::result::Result<[f64; 3], String> {
@@ -80,6 +99,25 @@ pub(crate) fn parse_unit(s: &str) -> std::result::Result<f64, String> {
 
 pub(crate) fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
     latvox::output::write_json(path, value)
+}
+
+/// Writes `value` to `report` if given and prints it if `json`; returns whether it was printed
+/// (the caller prints its human summary otherwise).
+pub(crate) fn emit_json(
+    report: Option<&Path>,
+    json: bool,
+    value: &serde_json::Value,
+) -> Result<bool> {
+    if let Some(r) = report {
+        write_json(r, value)?;
+    }
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(value).expect("JSON of plain values")
+        );
+    }
+    Ok(json)
 }
 
 pub(crate) fn yes(b: bool) -> &'static str {

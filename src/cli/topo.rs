@@ -2,7 +2,7 @@
 
 use super::{write_json, yes};
 use clap::Args;
-use latvox::stl::StlFormat;
+use latvox::io::stl::StlFormat;
 use latvox::topo::job::{self, TopoJob};
 use latvox::topo::volume::Smoothing;
 use latvox::topo::{CleanOptions, Density};
@@ -182,7 +182,7 @@ pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
     } else {
         StlFormat::Binary
     };
-    latvox::stl::save(&r.mesh, format, &a.output)?;
+    latvox::io::stl::save(&r.mesh, format, &a.output)?;
     let stamp = timestamp();
     let name = |p: &PathBuf| {
         p.file_name()

@@ -4,7 +4,7 @@ use super::{
     parse_counts, parse_density, parse_finite3, parse_positive3, parse_unit, write_json, yes,
 };
 use clap::Args;
-use latvox::stl::StlFormat;
+use latvox::io::stl::StlFormat;
 use latvox::tpms::{Domain, Structure, Surface, TpmsJob, TpmsReport};
 use latvox::{Error, Result};
 use std::path::PathBuf;

@@ -1,10 +1,12 @@
 //! STL, binary and ASCII. Writing computes facet normals from the winding (right-hand rule).
 //! Reading tells binary from ASCII by size and content — never by the word "solid", which binary
-//! headers may start with — and welds identical vertices.
+//! headers may start with — welds identical vertices, and keeps the stored normals so `check` can
+//! compare them with the winding.
 
+use super::weld::ExactWelder;
+use super::{Parsed, Words};
 use crate::error::{Error, Result};
 use crate::mesh::{cross, norm, sub, Mesh};
-use std::collections::HashMap;
 use std::io::Write;
 use std::path::Path;
 
@@ -106,17 +108,27 @@ pub fn read(path: &Path) -> Result<Mesh> {
 
 /// Parses STL bytes.
 pub fn parse(data: &[u8]) -> std::result::Result<Mesh, String> {
+    parse_facets(data).map(|p| p.mesh)
+}
+
+/// Parses STL bytes, keeping each facet's stored normal (as written, possibly zero or NaN).
+///
+/// Binary if the size is exactly `84 + 50·n` for the header's facet count `n`; otherwise ASCII
+/// if the first word is `solid` (any case) and the text parses; otherwise an error naming the
+/// mismatch. No allocation is ever sized from the header alone.
+pub fn parse_facets(data: &[u8]) -> std::result::Result<Parsed, String> {
     if data.len() >= 84 {
         let n = u32::from_le_bytes([data[80], data[81], data[82], data[83]]) as u64;
         if 84 + 50 * n == data.len() as u64 {
             return parse_binary(data, n as usize);
         }
     }
-    let looks_ascii = data
+    let first_word = data
         .iter()
-        .take(512)
         .position(|b| !b.is_ascii_whitespace())
-        .is_some_and(|i| data[i..].len() >= 5 && data[i..i + 5].eq_ignore_ascii_case(b"solid"));
+        .map(|i| &data[i..]);
+    let looks_ascii =
+        first_word.is_some_and(|w| w.len() >= 5 && w[..5].eq_ignore_ascii_case(b"solid"));
     if looks_ascii {
         return parse_ascii(data);
     }
@@ -131,85 +143,132 @@ pub fn parse(data: &[u8]) -> std::result::Result<Mesh, String> {
     ))
 }
 
-struct Welder {
-    map: HashMap<[u32; 3], u32>,
-    mesh: Mesh,
-}
-
-impl Welder {
-    fn new(capacity: usize) -> Self {
-        Welder {
-            map: HashMap::with_capacity(capacity),
-            mesh: Mesh::default(),
-        }
-    }
-
-    fn vertex(&mut self, p: [f32; 3]) -> std::result::Result<u32, String> {
-        if !p.iter().all(|v| v.is_finite()) {
-            return Err(format!("non-finite vertex coordinate {p:?}"));
-        }
-        // +0.0 and -0.0 are the same point.
-        let key = p.map(|v| if v == 0.0 { 0 } else { v.to_bits() });
-        let next = self.map.len() as u32;
-        let id = *self.map.entry(key).or_insert(next);
-        if id == next {
-            self.mesh.positions.extend_from_slice(&p);
-        }
-        Ok(id)
-    }
-}
-
-fn parse_binary(data: &[u8], n: usize) -> std::result::Result<Mesh, String> {
+fn parse_binary(data: &[u8], n: usize) -> std::result::Result<Parsed, String> {
+    use rayon::prelude::*;
     if n == 0 {
         return Err("binary STL with zero facets".into());
     }
-    let mut w = Welder::new(n / 2 + 16);
-    w.mesh.indices.reserve(3 * n);
-    for rec in data[84..].chunks_exact(50) {
-        for k in 0..3 {
-            let o = 12 + 12 * k;
-            let f = |j: usize| f32::from_le_bytes(rec[o + j..o + j + 4].try_into().unwrap());
-            let id = w.vertex([f(0), f(4), f(8)])?;
-            w.mesh.indices.push(id);
-        }
-    }
-    Ok(w.mesh)
+    // n is bounded by the file size here (checked by the caller).
+    let f = |rec: &[u8], o: usize| f32::from_le_bytes([rec[o], rec[o + 1], rec[o + 2], rec[o + 3]]);
+    let records = &data[84..];
+    let normals: Vec<[f32; 3]> = records
+        .par_chunks_exact(50)
+        .map(|r| [f(r, 0), f(r, 4), f(r, 8)])
+        .collect();
+    let corners: Vec<[f32; 3]> = records
+        .par_chunks_exact(50)
+        .flat_map_iter(|r| {
+            (0..3).map(move |k| [f(r, 12 + 12 * k), f(r, 16 + 12 * k), f(r, 20 + 12 * k)])
+        })
+        .collect();
+    Ok(Parsed {
+        mesh: super::weld::weld_corners(&corners)?,
+        normals: Some(normals),
+        ..Parsed::default()
+    })
 }
 
-fn parse_ascii(data: &[u8]) -> std::result::Result<Mesh, String> {
-    let text = String::from_utf8_lossy(data);
-    let mut w = Welder::new(1024);
-    let mut corners = 0usize;
-    for (lineno, line) in text.lines().enumerate() {
-        let mut it = line.split_whitespace();
-        let Some(word) = it.next() else { continue };
-        if word.eq_ignore_ascii_case("vertex") {
-            let mut p = [0f32; 3];
-            for v in p.iter_mut() {
-                *v = it
-                    .next()
-                    .and_then(|s| s.parse::<f32>().ok())
-                    .ok_or_else(|| format!("line {}: bad vertex", lineno + 1))?;
+/// ASCII STL as a stream of words; only `solid`/`endsolid` names are read to the end of their
+/// line. Keywords in any case; CR, LF or CRLF line ends; several solids in one file; text after
+/// the last `endsolid` ignored. Stored normals may be anything `f32` parses (`nan`, `+inf`).
+fn parse_ascii(data: &[u8]) -> std::result::Result<Parsed, String> {
+    let mut words = Words::new(data);
+    let mut w = ExactWelder::new(1024);
+    let mut normals = Vec::new();
+    let num = |words: &mut Words, what: &str| -> std::result::Result<f32, String> {
+        let line = words.line;
+        let tok = words
+            .next()
+            .ok_or_else(|| format!("line {line}: file ends inside a facet"))?;
+        std::str::from_utf8(tok)
+            .ok()
+            .and_then(|s| s.parse::<f32>().ok())
+            .ok_or_else(|| {
+                format!(
+                    "line {line}: bad {what} '{}'",
+                    String::from_utf8_lossy(&tok[..tok.len().min(24)])
+                )
+            })
+    };
+    let expect = |words: &mut Words, kw: &str| -> std::result::Result<(), String> {
+        let line = words.line;
+        match words.next() {
+            Some(t) if t.eq_ignore_ascii_case(kw.as_bytes()) => Ok(()),
+            Some(t) => Err(format!(
+                "line {line}: expected '{kw}', found '{}'",
+                String::from_utf8_lossy(&t[..t.len().min(24)])
+            )),
+            None => Err(format!("line {line}: file ends where '{kw}' was expected")),
+        }
+    };
+    let mut in_solid = false;
+    let mut saw_solid = false;
+    while let Some(tok) = words.next() {
+        if tok.eq_ignore_ascii_case(b"solid") {
+            if in_solid {
+                return Err(format!("line {}: 'solid' inside a solid", words.line));
             }
-            let id = w
-                .vertex(p)
-                .map_err(|e| format!("line {}: {e}", lineno + 1))?;
-            w.mesh.indices.push(id);
-            corners += 1;
-        } else if word.eq_ignore_ascii_case("endloop") && !corners.is_multiple_of(3) {
+            words.skip_line();
+            in_solid = true;
+            saw_solid = true;
+        } else if tok.eq_ignore_ascii_case(b"endsolid") {
+            words.skip_line();
+            in_solid = false;
+        } else if !in_solid && saw_solid {
+            // Trailing text after the last endsolid.
+            break;
+        } else if tok.eq_ignore_ascii_case(b"facet") {
+            let line = words.line;
+            let mut n = [0f32; 3];
+            match words.peek() {
+                Some(t) if t.eq_ignore_ascii_case(b"normal") => {
+                    words.next();
+                    for v in n.iter_mut() {
+                        *v = num(&mut words, "normal")?;
+                    }
+                }
+                _ => n = [f32::NAN; 3],
+            }
+            expect(&mut words, "outer")?;
+            expect(&mut words, "loop")?;
+            for _ in 0..3 {
+                expect(&mut words, "vertex")?;
+                let p = [
+                    num(&mut words, "vertex coordinate")?,
+                    num(&mut words, "vertex coordinate")?,
+                    num(&mut words, "vertex coordinate")?,
+                ];
+                w.corner(p)
+                    .map_err(|e| format!("line {}: {e}", words.line))?;
+            }
+            let l = words.line;
+            match words.next() {
+                Some(t) if t.eq_ignore_ascii_case(b"endloop") => {}
+                Some(t) if t.eq_ignore_ascii_case(b"vertex") => {
+                    return Err(format!(
+                        "line {l}: facet starting on line {line} has more than three vertices"
+                    ))
+                }
+                _ => return Err(format!("line {l}: expected 'endloop'")),
+            }
+            expect(&mut words, "endfacet")?;
+            normals.push(n);
+        } else {
             return Err(format!(
-                "line {}: facet without exactly three vertices",
-                lineno + 1
+                "line {}: unexpected '{}' in ASCII STL",
+                words.line,
+                String::from_utf8_lossy(&tok[..tok.len().min(24)])
             ));
         }
     }
-    if corners == 0 {
+    if normals.is_empty() {
         return Err("ASCII STL with no facets".into());
     }
-    if !corners.is_multiple_of(3) {
-        return Err("ASCII STL ends inside a facet".into());
-    }
-    Ok(w.mesh)
+    Ok(Parsed {
+        mesh: w.mesh,
+        normals: Some(normals),
+        ..Parsed::default()
+    })
 }
 
 /// Writes `mesh` to `path` atomically.

@@ -1,0 +1,230 @@
+//! Mesh check and repair benchmarks, with the figures quoted in README.
+//!
+//! The part: a torus of 1000 × 500 quads, 1,000,000 facets, written as binary STL (50 MB).
+//! 1. Reading it (`latvox::io::read`: parse, exact weld) in-process, and admesh on the same
+//!    file: `admesh -c` (read only, no checks) and `admesh` (its default checks and repairs).
+//! 2. `check` (every count, CGAL's self-intersection test included) and `repair` on the clean
+//!    part, and on a damaged copy (1 % of facets reversed, 20 holes cut out).
+//! 3. The whole `latvox repair` command on the damaged copy (read, check, repair, write, read the
+//!    written file back and check it again), as a user runs it.
+//!
+//! Medians of several runs, wall time and (in-process) CPU time of all threads. Run: `cargo bench --bench check` (add `-- --runs N`).
+
+use latvox::check::{check, CheckOptions};
+use latvox::io::{ReadOptions, StlFormat};
+use latvox::mesh::Mesh;
+use latvox::progress::Progress;
+use latvox::repair::{repair, RepairOptions};
+use std::process::Command;
+use std::time::Instant;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+/// CPU seconds (user + system) used by this process so far, all threads.
+fn cpu_seconds() -> f64 {
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: getrusage fills the struct we own.
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+    let tv = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    tv(u.ru_utime) + tv(u.ru_stime)
+}
+
+thread_local! {
+    /// Median CPU seconds of the last `time` call (the machine is shared: wall time alone varies
+    /// with the load from other work, CPU time much less).
+    static LAST_CPU: std::cell::Cell<f64> = const { std::cell::Cell::new(0.0) };
+}
+
+fn time<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
+    let mut times = Vec::new();
+    let mut cpu = Vec::new();
+    let mut last = None;
+    for _ in 0..runs {
+        let (t, c) = (Instant::now(), cpu_seconds());
+        last = Some(f());
+        times.push(t.elapsed().as_secs_f64());
+        cpu.push(cpu_seconds() - c);
+    }
+    LAST_CPU.with(|l| l.set(median(cpu)));
+    (median(times), last.expect("at least one run"))
+}
+
+fn cpu() -> f64 {
+    LAST_CPU.with(|l| l.get())
+}
+
+/// A torus (R = 40 mm, r = 15 mm) of `nu × nv` quads, wound outward.
+fn torus(nu: usize, nv: usize) -> Mesh {
+    let (big, small) = (40.0f64, 15.0f64);
+    let mut positions = Vec::with_capacity(3 * nu * nv);
+    for i in 0..nu {
+        let u = 2.0 * std::f64::consts::PI * i as f64 / nu as f64;
+        for j in 0..nv {
+            let v = 2.0 * std::f64::consts::PI * j as f64 / nv as f64;
+            let rr = big + small * v.cos();
+            positions.extend([
+                (rr * u.cos()) as f32,
+                (rr * u.sin()) as f32,
+                (small * v.sin()) as f32,
+            ]);
+        }
+    }
+    let id = |i: usize, j: usize| ((i % nu) * nv + (j % nv)) as u32;
+    let mut indices = Vec::with_capacity(6 * nu * nv);
+    for i in 0..nu {
+        for j in 0..nv {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            indices.extend([a, b, c, a, c, d]);
+        }
+    }
+    Mesh { positions, indices }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let runs = args
+        .iter()
+        .position(|a| a == "--runs")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5usize);
+    let threads = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    println!("machine: {threads} threads; {runs} runs per case, median reported");
+    let dir = tempfile::tempdir().unwrap();
+    let clean_path = dir.path().join("torus-1m.stl");
+    let clean = torus(1000, 500);
+    assert_eq!(clean.triangle_count(), 1_000_000);
+    assert!(clean.volume() > 0.0);
+    latvox::io::stl::save(&clean, StlFormat::Binary, &clean_path).unwrap();
+
+    // Damaged copy: every 100th facet reversed, and 20 patches of facets cut out.
+    let mut damaged = clean.clone();
+    for t in damaged.indices.chunks_exact_mut(3).step_by(100) {
+        t.swap(1, 2);
+    }
+    let mut keep = vec![true; damaged.triangle_count()];
+    for h in 0..20 {
+        let (i0, j0) = (50 * h, 25 * (h % 20));
+        for i in i0..i0 + 4 {
+            for j in j0..j0 + 4 {
+                let q = i * 500 + j;
+                keep[2 * q] = false;
+                keep[2 * q + 1] = false;
+            }
+        }
+    }
+    damaged.indices = damaged
+        .indices
+        .chunks_exact(3)
+        .zip(&keep)
+        .filter(|(_, k)| **k)
+        .flat_map(|(t, _)| t.to_vec())
+        .collect();
+    let damaged_path = dir.path().join("torus-1m-damaged.stl");
+    latvox::io::stl::save(&damaged, StlFormat::Binary, &damaged_path).unwrap();
+
+    println!("\n1. reading a {}-facet binary STL", clean.triangle_count());
+    let (t_read, loaded) = time(runs, || {
+        latvox::io::read(&clean_path, &ReadOptions::default()).unwrap()
+    });
+    println!(
+        "  latvox read (parse + exact weld)     {t_read:.3} s   (CPU {:.3} s; {} vertices)",
+        cpu(),
+        loaded.mesh.vertex_count()
+    );
+    let admesh = |flags: &[&str]| {
+        time(runs, || {
+            let s = Command::new("admesh")
+                .args(flags)
+                .arg(&clean_path)
+                .output()
+                .expect("admesh (scripts/install-deps.sh)");
+            assert!(s.status.success());
+        })
+        .0
+    };
+    let a_read = admesh(&["-c"]);
+    println!("  admesh -c (read, no checks)          {a_read:.3} s");
+    let a_all = admesh(&[]);
+    println!("  admesh (default checks and repairs)  {a_all:.3} s");
+
+    println!("\n2. check and repair in-process");
+    let progress = Progress::hidden();
+    for (label, mesh) in [
+        ("clean", &loaded.mesh),
+        ("damaged", &{
+            latvox::io::read(&damaged_path, &ReadOptions::default())
+                .unwrap()
+                .mesh
+        }),
+    ] {
+        let (t_check, rep) = time(runs, || {
+            check(mesh, None, &CheckOptions::default()).unwrap()
+        });
+        let c_check = cpu();
+        let (t_fast, _) = time(runs, || {
+            check(
+                mesh,
+                None,
+                &CheckOptions {
+                    self_intersections: false,
+                    tolerance: 0.0,
+                },
+            )
+            .unwrap()
+        });
+        let c_fast = cpu();
+        let (t_repair, (fixed, report)) = time(runs, || {
+            repair(mesh, &RepairOptions::default(), &progress).unwrap()
+        });
+        let c_repair = cpu();
+        let after = check(&fixed, None, &CheckOptions::default()).unwrap();
+        println!(
+            "  {label:8} check {t_check:.3} s (without self-intersections {t_fast:.3} s)  repair {t_repair:.3} s",
+        );
+        println!(
+            "           check + repair {:.3} s; without the self-intersection test {:.3} s",
+            t_check + t_repair,
+            t_fast + t_repair
+        );
+        println!(
+            "           CPU: check {c_check:.3} s, without self-intersections {c_fast:.3} s, repair {c_repair:.3} s",
+        );
+        println!(
+            "           defects before: {:?}; changes: {}; valid after: {}",
+            rep.defects(),
+            report
+                .changes
+                .iter()
+                .map(|c| format!("{} {}", c.count, c.kind))
+                .collect::<Vec<_>>()
+                .join(", "),
+            after.valid_solid
+        );
+    }
+
+    println!("\n3. the latvox repair command on the damaged part");
+    let exe = env!("CARGO_BIN_EXE_latvox");
+    let out = dir.path().join("fixed.stl");
+    let (t_cli, _) = time(runs, || {
+        let s = Command::new(exe)
+            .args(["repair", "-q"])
+            .arg(&damaged_path)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(
+            s.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&s.stdout)
+        );
+    });
+    println!("  latvox repair (read, check, repair, write, re-read, check)  {t_cli:.3} s");
+}

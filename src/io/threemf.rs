@@ -1,0 +1,376 @@
+//! 3MF (3D Manufacturing Format, core specification): a zip package holding
+//! `[Content_Types].xml`, `_rels/.rels` and the model XML (`3D/3dmodel.model`), whose `<object>`s
+//! carry `<mesh>`es (`<vertex x y z>`, `<triangle v1 v2 v3>`) or `<components>` referring to other
+//! objects, placed by the `<build>` `<item>`s with affine transforms. Units are converted to mm.
+//!
+//! Reading guards against hostile packages: the model is decompressed with a size cap, component
+//! nesting is bounded (no cycles), and the triangle count after instancing is computed before any
+//! copy is made and capped relative to what the file stores.
+
+use super::{Parsed, PolygonSink};
+use crate::mesh::Mesh;
+use quick_xml::events::{BytesStart, Event};
+use std::collections::HashMap;
+use std::io::{Cursor, Read, Write};
+
+const MODEL_NS: &str = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02";
+const REL_3DMODEL: &str = "http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel";
+/// Decompressed model XML larger than this is refused.
+const MAX_MODEL_BYTES: u64 = 4 << 30;
+/// Component nesting deeper than this is refused (the spec forbids cycles).
+const MAX_DEPTH: usize = 16;
+
+/// An affine map in 3MF's layout: `p' = (x, y, z, 1) · M`, M 4×3, stored row by row.
+type Transform = [f64; 12];
+const IDENTITY: Transform = [1., 0., 0., 0., 1., 0., 0., 0., 1., 0., 0., 0.];
+
+fn compose(a: &Transform, b: &Transform) -> Transform {
+    // Apply a, then b.
+    let mut m = [0.0; 12];
+    for r in 0..4 {
+        for c in 0..3 {
+            let mut v = if r == 3 { b[9 + c] } else { 0.0 };
+            for k in 0..3 {
+                v += a[3 * r + k] * b[3 * k + c];
+            }
+            m[3 * r + c] = v;
+        }
+    }
+    m
+}
+
+fn apply(m: &Transform, p: [f32; 3]) -> [f32; 3] {
+    let [x, y, z] = p.map(|v| v as f64);
+    [0, 1, 2].map(|c| (x * m[c] + y * m[3 + c] + z * m[6 + c] + m[9 + c]) as f32)
+}
+
+#[derive(Default)]
+struct Object {
+    positions: Vec<f32>,
+    triangles: Vec<u32>,
+    components: Vec<(u64, Transform)>,
+}
+
+fn attr(e: &BytesStart, name: &str) -> Result<Option<String>, String> {
+    for a in e.attributes() {
+        let a = a.map_err(|e| format!("bad XML attribute: {e}"))?;
+        if a.key.local_name().as_ref() == name {
+            return Ok(Some(a.value.to_string()));
+        }
+    }
+    Ok(None)
+}
+
+fn num<T: std::str::FromStr>(e: &BytesStart, name: &str) -> Result<T, String> {
+    let v =
+        attr(e, name)?.ok_or_else(|| format!("<{}> without {}", e.local_name().as_ref(), name))?;
+    v.trim()
+        .parse()
+        .map_err(|_| format!("bad {} '{}'", name, v.chars().take(24).collect::<String>()))
+}
+
+/// A `transform` attribute, its translation converted from model units to mm.
+fn transform(e: &BytesStart, scale: f64) -> Result<Transform, String> {
+    let Some(t) = attr(e, "transform")? else {
+        return Ok(IDENTITY);
+    };
+    let v: Vec<f64> = t
+        .split_whitespace()
+        .map(|s| s.parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| "bad transform".to_string())?;
+    if v.len() != 12 || !v.iter().all(|x| x.is_finite()) {
+        return Err("a transform needs 12 finite numbers".into());
+    }
+    let mut m: Transform = v.try_into().expect("12 values");
+    for t in &mut m[9..] {
+        *t *= scale;
+    }
+    Ok(m)
+}
+
+fn read_entry(zip: &mut zip::ZipArchive<Cursor<&[u8]>>, name: &str) -> Result<Vec<u8>, String> {
+    let f = zip
+        .by_name(name)
+        .map_err(|e| format!("package has no readable {name}: {e}"))?;
+    if f.size() > MAX_MODEL_BYTES {
+        return Err(format!("{name} is larger than 4 GiB"));
+    }
+    let mut out = Vec::new();
+    f.take(MAX_MODEL_BYTES + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| format!("{name}: {e}"))?;
+    if out.len() as u64 > MAX_MODEL_BYTES {
+        return Err(format!("{name} is larger than 4 GiB"));
+    }
+    Ok(out)
+}
+
+fn model_path(zip: &mut zip::ZipArchive<Cursor<&[u8]>>) -> String {
+    let fallback = "3D/3dmodel.model".to_string();
+    let Ok(rels) = read_entry(zip, "_rels/.rels") else {
+        return fallback;
+    };
+    let Ok(text) = std::str::from_utf8(&rels) else {
+        return fallback;
+    };
+    let mut r = quick_xml::Reader::from_str(text);
+    while let Ok(ev) = r.read_event() {
+        match ev {
+            Event::Empty(e) | Event::Start(e)
+                if e.local_name().as_ref() == "Relationship"
+                    && attr(&e, "Type").ok().flatten().as_deref() == Some(REL_3DMODEL) =>
+            {
+                if let Ok(Some(t)) = attr(&e, "Target") {
+                    return t.trim_start_matches('/').to_string();
+                }
+            }
+            Event::Eof => break,
+            _ => {}
+        }
+    }
+    fallback
+}
+
+/// Parses a 3MF package.
+pub fn parse(data: &[u8]) -> Result<Parsed, String> {
+    let mut zip =
+        zip::ZipArchive::new(Cursor::new(data)).map_err(|e| format!("not a zip package: {e}"))?;
+    let path = model_path(&mut zip);
+    let xml = read_entry(&mut zip, &path)?;
+    let text = std::str::from_utf8(&xml).map_err(|_| "model XML is not UTF-8".to_string())?;
+    let mut r = quick_xml::Reader::from_str(text);
+    let mut objects: HashMap<u64, Object> = HashMap::new();
+    let mut items: Vec<(u64, Transform)> = Vec::new();
+    let mut current: Option<u64> = None;
+    let mut scale = 1.0f64;
+    let mut stored_triangles = 0u64;
+    loop {
+        let ev = r
+            .read_event()
+            .map_err(|e| format!("model XML: {e} (at byte {})", r.buffer_position()))?;
+        let (e, empty) = match ev {
+            Event::Start(e) => (e, false),
+            Event::Empty(e) => (e, true),
+            Event::End(e) => {
+                if e.local_name().as_ref() == "object" {
+                    current = None;
+                }
+                continue;
+            }
+            Event::Eof => break,
+            _ => continue,
+        };
+        match e.local_name().as_ref() {
+            "model" => {
+                scale = match attr(&e, "unit")?.as_deref().unwrap_or("millimeter") {
+                    "micron" => 0.001,
+                    "millimeter" => 1.0,
+                    "centimeter" => 10.0,
+                    "inch" => 25.4,
+                    "foot" => 304.8,
+                    "meter" => 1000.0,
+                    u => {
+                        return Err(format!(
+                            "unknown unit '{}'",
+                            u.chars().take(24).collect::<String>()
+                        ))
+                    }
+                };
+            }
+            "object" => {
+                let id: u64 = num(&e, "id")?;
+                if objects.contains_key(&id) {
+                    return Err(format!("object id {id} defined twice"));
+                }
+                objects.insert(id, Object::default());
+                current = (!empty).then_some(id);
+            }
+            "vertex" => {
+                let id = current.ok_or("<vertex> outside an <object>")?;
+                let o = objects.get_mut(&id).ok_or("<vertex> outside an <object>")?;
+                let p: [f32; 3] = [num(&e, "x")?, num(&e, "y")?, num(&e, "z")?];
+                if !p.iter().all(|v| v.is_finite()) {
+                    return Err(format!("non-finite vertex coordinate {p:?}"));
+                }
+                o.positions.extend(p.map(|v| (v as f64 * scale) as f32));
+            }
+            "triangle" => {
+                let id = current.ok_or("<triangle> outside an <object>")?;
+                let o = objects
+                    .get_mut(&id)
+                    .ok_or("<triangle> outside an <object>")?;
+                let t: [u32; 3] = [num(&e, "v1")?, num(&e, "v2")?, num(&e, "v3")?];
+                let nv = o.positions.len() / 3;
+                if t.iter().any(|&i| i as usize >= nv) {
+                    return Err(format!(
+                        "triangle {t:?} names a vertex past the {nv} vertices"
+                    ));
+                }
+                o.triangles.extend_from_slice(&t);
+                stored_triangles += 1;
+            }
+            "component" => {
+                let id = current.ok_or("<component> outside an <object>")?;
+                let o = objects
+                    .get_mut(&id)
+                    .ok_or("<component> outside an <object>")?;
+                o.components
+                    .push((num(&e, "objectid")?, transform(&e, scale)?));
+            }
+            "item" => items.push((num(&e, "objectid")?, transform(&e, scale)?)),
+            _ => {}
+        }
+    }
+    if items.is_empty() {
+        return Err("no <build> <item>".into());
+    }
+    // Triangles after instancing, computed before copying anything.
+    fn count(objects: &HashMap<u64, Object>, id: u64, depth: usize) -> Result<u64, String> {
+        if depth > MAX_DEPTH {
+            return Err("components nested too deeply (or in a cycle)".into());
+        }
+        let o = objects
+            .get(&id)
+            .ok_or_else(|| format!("reference to undefined object {id}"))?;
+        let mut n = (o.triangles.len() / 3) as u64;
+        for (c, _) in &o.components {
+            n = n.saturating_add(count(objects, *c, depth + 1)?);
+        }
+        Ok(n)
+    }
+    let mut total = 0u64;
+    for (id, _) in &items {
+        total = total.saturating_add(count(&objects, *id, 0)?);
+    }
+    let cap = 20_000_000 + 16 * stored_triangles;
+    if total > cap {
+        return Err(format!(
+            "build expands {stored_triangles} stored triangles to {total}, over the limit of {cap}"
+        ));
+    }
+    fn emit(
+        objects: &HashMap<u64, Object>,
+        id: u64,
+        m: &Transform,
+        sink: &mut PolygonSink,
+    ) -> Result<(), String> {
+        let o = &objects[&id];
+        let base = sink.vertex_count() as u32;
+        for p in o.positions.chunks_exact(3) {
+            sink.push_vertex(apply(m, [p[0], p[1], p[2]]))?;
+        }
+        for t in o.triangles.chunks_exact(3) {
+            for &i in t {
+                sink.corner(base + i);
+            }
+            sink.end_face()?;
+        }
+        for (c, t) in &o.components {
+            emit(objects, *c, &compose(t, m), sink)?;
+        }
+        Ok(())
+    }
+    let mut sink = PolygonSink::new();
+    for (id, t) in &items {
+        emit(&objects, *id, t, &mut sink)?;
+    }
+    sink.finish()
+}
+
+/// Writes a 3MF package with one mesh object and one build item.
+pub fn write(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
+    if let Some(t) = mesh
+        .indices
+        .chunks_exact(3)
+        .position(|t| t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
+    {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("3MF forbids degenerate triangles and triangle {t} repeats a vertex (run `latvox repair`)"),
+        ));
+    }
+    let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
+    let opts = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    let z = |e: zip::result::ZipError| std::io::Error::other(e);
+    zip.start_file("[Content_Types].xml", opts).map_err(z)?;
+    zip.write_all(
+        br#"<?xml version="1.0" encoding="UTF-8"?>
+<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types"><Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/><Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/></Types>
+"#,
+    )?;
+    zip.start_file("_rels/.rels", opts).map_err(z)?;
+    write!(
+        zip,
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="{REL_3DMODEL}"/></Relationships>
+"#
+    )?;
+    zip.start_file("3D/3dmodel.model", opts).map_err(z)?;
+    {
+        let mut x = std::io::BufWriter::with_capacity(1 << 16, &mut zip);
+        write!(
+            x,
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" xml:lang=\"en-US\" xmlns=\"{MODEL_NS}\">\n<metadata name=\"Application\">latvox</metadata>\n<resources>\n<object id=\"1\" type=\"model\">\n<mesh>\n<vertices>\n"
+        )?;
+        for p in mesh.positions.chunks_exact(3) {
+            writeln!(x, "<vertex x=\"{}\" y=\"{}\" z=\"{}\"/>", p[0], p[1], p[2])?;
+        }
+        writeln!(x, "</vertices>\n<triangles>")?;
+        for t in mesh.indices.chunks_exact(3) {
+            writeln!(
+                x,
+                "<triangle v1=\"{}\" v2=\"{}\" v3=\"{}\"/>",
+                t[0], t[1], t[2]
+            )?;
+        }
+        writeln!(
+            x,
+            "</triangles>\n</mesh>\n</object>\n</resources>\n<build>\n<item objectid=\"1\"/>\n</build>\n</model>"
+        )?;
+        x.flush()?;
+    }
+    let buf = zip.finish().map_err(z)?.into_inner();
+    w.write_all(&buf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_and_components_with_transforms() {
+        let m = Mesh {
+            positions: vec![0., 0., 0., 1., 0., 0., 0., 1., 0., 0., 0., 1.],
+            indices: vec![0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3],
+        };
+        let mut b = Vec::new();
+        write(&m, &mut b).unwrap();
+        assert_eq!(parse(&b).unwrap().mesh, m);
+        let degenerate = Mesh {
+            positions: m.positions.clone(),
+            indices: vec![0, 0, 1],
+        };
+        assert!(write(&degenerate, &mut Vec::new()).is_err());
+    }
+
+    #[test]
+    fn units_components_and_build_transforms_compose() {
+        // Centimetres; object 2 = tetra 1 twice, the second moved 5 cm along x; the build item
+        // scales by 2 and lifts by 1 cm. Model path given by _rels/.rels (not the default).
+        let data = include_bytes!("../../fuzz/corpus/threemf/components-transforms.3mf");
+        let m = parse(data).unwrap().mesh;
+        assert_eq!(m.triangle_count(), 8);
+        let b = m.bounds().unwrap();
+        assert!(
+            (b.min[0] - 0.0).abs() < 1e-4 && (b.max[0] - 120.0).abs() < 1e-4,
+            "{b:?}"
+        );
+        assert!(
+            (b.min[2] - 10.0).abs() < 1e-4 && (b.max[2] - 30.0).abs() < 1e-4,
+            "{b:?}"
+        );
+        assert!((m.volume() - 2.0 * 20.0f64.powi(3) / 6.0).abs() < 1e-3);
+    }
+}
