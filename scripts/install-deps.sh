@@ -36,9 +36,11 @@ else
 fi
 
 # Python packages for the tests: NumPy/SciPy (reference optimisers, independent checks of the
-# cleaned fields), gmsh (OpenCASCADE reads the IGES back) and ezdxf (reads the DXF back).
-PY_PKGS=(numpy scipy gmsh ezdxf)
-if python3 -c "import numpy, scipy, gmsh, ezdxf" 2>/dev/null; then
+# cleaned fields), gmsh (OpenCASCADE reads the IGES back), ezdxf (reads the DXF back), and
+# trimesh with networkx and lxml (an independent mesh analyser for check/repair).
+PY_PKGS=(numpy scipy gmsh ezdxf trimesh networkx lxml)
+PY_IMPORTS="import numpy, scipy, gmsh, ezdxf, trimesh, networkx, lxml"
+if python3 -c "$PY_IMPORTS" 2>/dev/null; then
   echo "install-deps: Python packages present" >&2
 else
   echo "install-deps: installing Python packages ${PY_PKGS[*]}" >&2
@@ -48,12 +50,7 @@ else
   else
     pip_install --user 2>/dev/null || pip_install --user --break-system-packages
   fi
-  python3 -c "import numpy, scipy, gmsh, ezdxf"
-# Mesh check/repair tests: trimesh (PyPI) as an independent mesh analyser.
-if ! python3 -c "import trimesh, networkx, lxml" 2>/dev/null; then
-  echo "install-deps: installing trimesh (PyPI)" >&2
-  python3 -m pip install --quiet --disable-pip-version-check trimesh networkx lxml numpy \
-    || python3 -m pip install --quiet --disable-pip-version-check --break-system-packages trimesh networkx lxml numpy
+  python3 -c "$PY_IMPORTS"
 fi
 
 # Fuzzing the mesh readers inside `cargo test`: cargo-fuzz on a nightly toolchain.

@@ -47,6 +47,17 @@ impl GridSpec {
         }
     }
 
+    /// The samples a whole part is meshed from: the region of interest and the narrow band
+    /// around it, widened to whole 8³ blocks.
+    pub fn padded_region(&self) -> IndexBox {
+        let pad = self.half_width.ceil() as i64 + 1;
+        IndexBox {
+            lo: [-pad; 3],
+            hi: [0, 1, 2].map(|a| self.dims[a] + pad),
+        }
+        .to_blocks()
+    }
+
     pub fn point(&self, i: [i64; 3]) -> Vec3 {
         [0, 1, 2].map(|a| self.origin[a] + (i[a] as f64 + 0.5) * self.voxel)
     }
@@ -62,6 +73,20 @@ pub struct IndexBox {
 impl IndexBox {
     pub fn contains(&self, i: [i64; 3]) -> bool {
         (0..3).all(|a| i[a] >= self.lo[a] && i[a] < self.hi[a])
+    }
+
+    /// The smallest box of whole 8³ blocks holding this one.
+    pub fn to_blocks(&self) -> IndexBox {
+        IndexBox {
+            lo: self.lo.map(|x| x.div_euclid(8) * 8),
+            hi: self.hi.map(|x| (x + 7).div_euclid(8) * 8),
+        }
+    }
+
+    pub fn voxels(&self) -> u64 {
+        (0..3)
+            .map(|a| (self.hi[a] - self.lo[a]).max(0) as u64)
+            .product()
     }
 
     /// The box grown by `m` samples on every side.
@@ -98,12 +123,7 @@ pub fn set_backend_threads(n: usize) {
 impl Grid {
     /// Samples `field` on the narrow band of its zero set within the padded region of `spec`.
     pub fn sample(field: &dyn Field, spec: GridSpec) -> Result<Grid> {
-        let pad = spec.half_width.ceil() as i64 + 1;
-        let region = IndexBox {
-            lo: [-pad; 3],
-            hi: [0, 1, 2].map(|a| spec.dims[a] + pad),
-        };
-        Self::sample_box(field, spec, region)
+        Self::sample_box(field, spec, spec.padded_region())
     }
 
     /// Samples `field` on the narrow band within the leaf blocks that cover `region` (sample

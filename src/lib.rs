@@ -23,6 +23,7 @@ pub mod progress;
 pub mod repair;
 pub mod sink;
 pub mod snap;
+pub mod tile;
 pub mod topo;
 pub mod topology;
 pub mod topopt;

@@ -20,6 +20,8 @@ fn every_type_and_structure_hits_its_target_within_0_002() {
                     auto_resolution: true,
                     self_intersection: false,
                     instancing: true,
+                    tile: None,
+                    memory: None,
                 };
                 let (mesh, r) = job.run(&latvox::progress::Progress::hidden()).unwrap();
                 assert!(

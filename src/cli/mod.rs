@@ -97,6 +97,32 @@ pub(crate) fn parse_unit(s: &str) -> std::result::Result<f64, String> {
     }
 }
 
+/// A size in bytes: a number with an optional K, M, G or T suffix (powers of 1024).
+pub(crate) fn parse_size(s: &str) -> std::result::Result<u64, String> {
+    let t = s.trim();
+    let (num, mult) = match t.chars().last().map(|c| c.to_ascii_uppercase()) {
+        Some('K') => (&t[..t.len() - 1], 1u64 << 10),
+        Some('M') => (&t[..t.len() - 1], 1 << 20),
+        Some('G') => (&t[..t.len() - 1], 1 << 30),
+        Some('T') => (&t[..t.len() - 1], 1 << 40),
+        _ => (t, 1),
+    };
+    match num.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok((v * mult as f64) as u64),
+        _ => Err(format!("'{s}' is not a size (examples: 2G, 512M, 1000000)")),
+    }
+}
+
+/// A tile edge in voxels: a multiple of 8, at least 16.
+pub(crate) fn parse_tile(s: &str) -> std::result::Result<i64, String> {
+    match s.trim().parse::<i64>() {
+        Ok(v) if v >= 16 && v % 8 == 0 => Ok(v),
+        _ => Err(format!(
+            "tile must be a multiple of 8 voxels, at least 16, got '{s}'"
+        )),
+    }
+}
+
 pub(crate) fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
     latvox::output::write_json(path, value)
 }

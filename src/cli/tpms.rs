@@ -1,7 +1,8 @@
 //! `latvox tpms`: a closed TPMS lattice at an exact volume fraction.
 
 use super::{
-    parse_counts, parse_density, parse_finite3, parse_positive3, parse_unit, write_json, yes,
+    parse_counts, parse_density, parse_finite3, parse_positive3, parse_size, parse_tile,
+    parse_unit, write_json, yes,
 };
 use clap::Args;
 use latvox::io::stl::StlFormat;
@@ -83,6 +84,14 @@ pub struct TpmsArgs {
     /// 3×3×3-cell template (slower, same solid; CGAL then checks the whole part).
     #[arg(long)]
     pub no_instancing: bool,
+    /// Memory budget while meshing, e.g. 2G or 512M: a part whose grid would not fit is meshed
+    /// in tiles sized from it and streamed to the file (default 4G).
+    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+    pub memory: Option<u64>,
+    /// Mesh in tiles of this many voxels a side (a multiple of 8, at least 16), whatever the
+    /// part's size; the tiled part is the same solid as the untiled one.
+    #[arg(long, value_name = "VOXELS", value_parser = parse_tile)]
+    pub tile: Option<i64>,
 }
 
 pub(crate) fn parse_surface(s: &str) -> std::result::Result<Surface, String> {
@@ -144,6 +153,8 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
         auto_resolution: !a.fixed_resolution,
         self_intersection: !a.no_self_intersection_check,
         instancing: !a.no_instancing,
+        tile: a.tile,
+        memory: a.memory,
     };
     latvox::output::check_writable(&a.output)?;
     let format = if a.ascii {

@@ -5,9 +5,11 @@ use super::instance::{self, Template};
 use super::{Domain, Lattice, MeshingStats, Structure, Surface};
 use crate::error::{Error, Result};
 use crate::field::Aabb;
+use crate::grid::{GridSpec, IndexBox};
 use crate::mesh::Mesh;
 use crate::progress::Progress;
 use crate::sink::{Measures, MeshCollector, MeshSink, Triangle};
+use crate::tile;
 use crate::verify::{verify, verify_on, Verification};
 use std::time::Instant;
 
@@ -36,6 +38,11 @@ pub struct TpmsJob {
     /// Copy a periodic part's cells from a meshed template where possible ([`instance`]);
     /// otherwise the whole part is meshed at once.
     pub instancing: bool,
+    /// Mesh in tiles of this many samples a side (a multiple of 8), whatever the part's size.
+    pub tile: Option<i64>,
+    /// Memory budget, bytes: parts whose grid would not fit are meshed in tiles sized from it
+    /// ([`DEFAULT_MEMORY`] when not given).
+    pub memory: Option<u64>,
 }
 
 /// Timings per stage, seconds.
@@ -62,6 +69,21 @@ pub struct Instancing {
     /// part is written as exact copies of its cells.
     pub verified: &'static str,
 }
+
+/// How the part was meshed when it was meshed in tiles (see [`crate::tile`]).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Tiling {
+    pub tiles: u64,
+    /// Tile edge, samples.
+    pub tile_samples: i64,
+    /// Samples meshed around each tile and not kept.
+    pub margin_samples: i64,
+    pub verified: &'static str,
+}
+
+/// Memory a part may use while it is meshed when no budget is given: larger parts are meshed
+/// in tiles.
+pub const DEFAULT_MEMORY: u64 = 4 << 30;
 
 /// The JSON report of a TPMS job.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -95,6 +117,7 @@ pub struct TpmsReport {
     /// CGAL's checks: on the written mesh, or on the template when `instancing` is set.
     pub checks: Verification,
     pub instancing: Option<Instancing>,
+    pub tiling: Option<Tiling>,
     pub meshing: MeshingStats,
     pub timings: Timings,
     pub warnings: Vec<String>,
@@ -209,80 +232,24 @@ impl TpmsJob {
             bounds,
             phase: bounds.min,
         };
-        let plan = if self.instancing && self.adaptivity == 0.0 {
-            instance::plan(self.domain.size, cell, voxel)
-        } else {
-            None
+        let route = self.route(&lattice, voxel);
+        let written = match route {
+            Route::Instanced(plan) => {
+                self.write_instanced(&lattice, voxel, plan, progress, sink)?
+            }
+            Route::Tiled(edge) => self.write_tiled(&lattice, voxel, edge, progress, sink)?,
+            Route::Whole => self.write_whole(&lattice, voxel, progress, sink)?,
         };
-        let (checks, meshing, measures, vertices, instancing, verify_seconds, write_seconds) =
-            match plan {
-                Some(plan) => {
-                    let (template, meshing) = {
-                        let _p = progress.stage("sampling and meshing the template");
-                        Template::build(&lattice, voxel, plan)?
-                    };
-                    // CGAL checks the template while the part is written: the two share the cores.
-                    let template_mesh = template.mesh.to_mesh();
-                    let (checks, verify_seconds, measures, write_seconds) = {
-                        let _p = progress.stage("writing the part and verifying its template");
-                        std::thread::scope(|scope| {
-                            let checker = scope.spawn(|| {
-                                let t = Instant::now();
-                                let r = verify_on(&template_mesh, self.self_intersection, false);
-                                (r, t.elapsed().as_secs_f64())
-                            });
-                            let t = Instant::now();
-                            let measures = template.expand(sink);
-                            let write_seconds = t.elapsed().as_secs_f64();
-                            let (checks, verify_seconds) =
-                                checker.join().expect("the CGAL check does not panic");
-                            (checks, verify_seconds, measures, write_seconds)
-                        })
-                    };
-                    let (checks, measures) = (checks?, measures?);
-                    let instancing = Instancing {
-                        part_cells: plan.map(|a| a.n),
-                        template_cells: plan.map(|a| a.m),
-                        template_triangles: template.mesh.triangle_count() as u64,
-                        verified: "template",
-                    };
-                    (
-                        checks,
-                        meshing,
-                        measures,
-                        template.vertex_count(),
-                        Some(instancing),
-                        verify_seconds,
-                        write_seconds,
-                    )
-                }
-                None => {
-                    let (mesh, meshing) = {
-                        let _p = progress.stage("sampling and meshing");
-                        lattice.mesh(voxel, self.adaptivity)?
-                    };
-                    let t = Instant::now();
-                    let checks = {
-                        let _p = progress.stage("verifying with CGAL");
-                        verify(&mesh, self.self_intersection)?
-                    };
-                    let verify_seconds = t.elapsed().as_secs_f64();
-                    let t = Instant::now();
-                    let measures = {
-                        let _p = progress.stage("writing the part");
-                        write_mesh(&mesh, sink)?
-                    };
-                    (
-                        checks,
-                        meshing,
-                        measures,
-                        mesh.vertex_count() as u64,
-                        None,
-                        verify_seconds,
-                        t.elapsed().as_secs_f64(),
-                    )
-                }
-            };
+        let Written {
+            checks,
+            meshing,
+            measures,
+            vertices,
+            instancing,
+            tiling,
+            verify_seconds,
+            write_seconds,
+        } = written;
         let volume = measures.volume;
         let achieved = volume / bounds.volume();
         if !checks.is_valid_solid() && (checks.self_intersection_checked || !checks.closed) {
@@ -315,6 +282,7 @@ impl TpmsJob {
             bounding_box: (measures.triangles > 0).then_some(measures.bounds),
             checks,
             instancing,
+            tiling,
             timings: Timings {
                 calibrate: cal.seconds,
                 sample: meshing.sample_seconds,
@@ -327,6 +295,190 @@ impl TpmsJob {
             meshing,
             warnings,
             output: None,
+        })
+    }
+}
+
+/// How a part is meshed.
+enum Route {
+    /// Copied cell by cell from a meshed template.
+    Instanced([instance::AxisPlan; 3]),
+    /// Meshed tile by tile, tiles of this many samples a side.
+    Tiled(i64),
+    /// Meshed at once.
+    Whole,
+}
+
+/// What writing the part gave.
+struct Written {
+    checks: Verification,
+    meshing: MeshingStats,
+    measures: Measures,
+    vertices: u64,
+    instancing: Option<Instancing>,
+    tiling: Option<Tiling>,
+    verify_seconds: f64,
+    write_seconds: f64,
+}
+
+impl TpmsJob {
+    fn route(&self, lattice: &Lattice, voxel: f64) -> Route {
+        if self.adaptivity != 0.0 {
+            return Route::Whole;
+        }
+        if self.instancing && self.tile.is_none() {
+            if let Some(plan) = instance::plan(self.domain.size, lattice.cell, voxel) {
+                return Route::Instanced(plan);
+            }
+        }
+        if let Some(edge) = self.tile {
+            return Route::Tiled(edge);
+        }
+        let spec = GridSpec::covering(&lattice.bounds, voxel, super::HALF_WIDTH);
+        let budget = self.memory.unwrap_or(DEFAULT_MEMORY);
+        if spec.padded_region().voxels() * tile::BYTES_PER_VOXEL > budget {
+            Route::Tiled(tile::tile_edge_for_budget(budget))
+        } else {
+            Route::Whole
+        }
+    }
+
+    fn write_instanced(
+        &self,
+        lattice: &Lattice,
+        voxel: f64,
+        plan: [instance::AxisPlan; 3],
+        progress: &Progress,
+        sink: &mut dyn MeshSink,
+    ) -> Result<Written> {
+        let (template, meshing) = {
+            let _p = progress.stage("sampling and meshing the template");
+            Template::build(lattice, voxel, plan)?
+        };
+        // CGAL checks the template while the part is written: the two share the cores.
+        let template_mesh = template.mesh.to_mesh();
+        let (checks, verify_seconds, measures, write_seconds) = {
+            let _p = progress.stage("writing the part and verifying its template");
+            std::thread::scope(|scope| {
+                let checker = scope.spawn(|| {
+                    let t = Instant::now();
+                    let r = verify_on(&template_mesh, self.self_intersection, false);
+                    (r, t.elapsed().as_secs_f64())
+                });
+                let t = Instant::now();
+                let measures = template.expand(sink);
+                let write_seconds = t.elapsed().as_secs_f64();
+                let (checks, verify_seconds) =
+                    checker.join().expect("the CGAL check does not panic");
+                (checks, verify_seconds, measures, write_seconds)
+            })
+        };
+        Ok(Written {
+            checks: checks?,
+            meshing,
+            measures: measures?,
+            vertices: template.vertex_count(),
+            instancing: Some(Instancing {
+                part_cells: plan.map(|a| a.n),
+                template_cells: plan.map(|a| a.m),
+                template_triangles: template.mesh.triangle_count() as u64,
+                verified: "template",
+            }),
+            tiling: None,
+            verify_seconds,
+            write_seconds,
+        })
+    }
+
+    fn write_tiled(
+        &self,
+        lattice: &Lattice,
+        voxel: f64,
+        edge: i64,
+        progress: &Progress,
+        sink: &mut dyn MeshSink,
+    ) -> Result<Written> {
+        let spec = GridSpec::covering(&lattice.bounds, voxel, super::HALF_WIDTH);
+        let stats = std::sync::Mutex::new(MeshingStats::default());
+        let mesh_tile = |r: IndexBox| {
+            let (m, s) = lattice.mesh_keyed_in(spec, Some(r), 0.0)?;
+            let mut total = stats.lock().expect("no panic while holding the lock");
+            total.add(&s);
+            Ok(m)
+        };
+        let t = Instant::now();
+        let out = {
+            let _p = progress.stage("meshing and writing the part tile by tile");
+            tile::mesh_tiled(
+                spec.padded_region(),
+                edge,
+                &mesh_tile,
+                self.self_intersection,
+                sink,
+            )?
+        };
+        let closed = out.bad_edges == 0;
+        let m = out.measures;
+        Ok(Written {
+            checks: Verification {
+                manifold: closed,
+                closed,
+                outward: closed && m.volume > 0.0,
+                self_intersection_checked: out.self_intersection_checked,
+                self_intersecting: out.self_intersecting,
+                volume: closed.then_some(m.volume),
+                area: m.area,
+                faces: m.triangles,
+                vertices: out.vertices,
+                border_edges: out.bad_edges,
+                components: 0,
+            },
+            meshing: stats.into_inner().expect("no panic while holding the lock"),
+            measures: m,
+            vertices: out.vertices,
+            instancing: None,
+            tiling: Some(Tiling {
+                tiles: out.tiles,
+                tile_samples: edge,
+                margin_samples: tile::MARGIN,
+                verified: "per tile: edges counted by latvox, self-intersection by CGAL",
+            }),
+            verify_seconds: 0.0,
+            write_seconds: t.elapsed().as_secs_f64(),
+        })
+    }
+
+    fn write_whole(
+        &self,
+        lattice: &Lattice,
+        voxel: f64,
+        progress: &Progress,
+        sink: &mut dyn MeshSink,
+    ) -> Result<Written> {
+        let (mesh, meshing) = {
+            let _p = progress.stage("sampling and meshing");
+            lattice.mesh(voxel, self.adaptivity)?
+        };
+        let t = Instant::now();
+        let checks = {
+            let _p = progress.stage("verifying with CGAL");
+            verify(&mesh, self.self_intersection)?
+        };
+        let verify_seconds = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let measures = {
+            let _p = progress.stage("writing the part");
+            write_mesh(&mesh, sink)?
+        };
+        Ok(Written {
+            checks,
+            meshing,
+            measures,
+            vertices: mesh.vertex_count() as u64,
+            instancing: None,
+            tiling: None,
+            verify_seconds,
+            write_seconds: t.elapsed().as_secs_f64(),
         })
     }
 }

@@ -20,7 +20,7 @@ pub use surface::{Structure, Surface, TpmsField};
 use crate::error::{Error, Result};
 use crate::extract::KeyedMesh;
 use crate::field::{Aabb, Intersection, Vec3};
-use crate::grid::{Grid, GridSpec};
+use crate::grid::{Grid, GridSpec, IndexBox};
 use crate::mesh::Mesh;
 use crate::snap::{snap, SnapStats};
 
@@ -55,6 +55,21 @@ pub struct MeshingStats {
     pub snap_seconds: f64,
 }
 
+impl MeshingStats {
+    /// Adds another pass's counts and times (tiles of one part).
+    pub fn add(&mut self, o: &MeshingStats) {
+        self.voxel_size = o.voxel_size;
+        self.blocks_tested += o.blocks_tested;
+        self.blocks_sampled += o.blocks_sampled;
+        self.active_voxels += o.active_voxels;
+        self.grid_bytes = self.grid_bytes.max(o.grid_bytes);
+        self.snap += o.snap;
+        self.sample_seconds += o.sample_seconds;
+        self.mesh_seconds += o.mesh_seconds;
+        self.snap_seconds += o.snap_seconds;
+    }
+}
+
 impl Lattice {
     pub fn field(&self, clamp: f64) -> TpmsField {
         TpmsField::new(
@@ -87,6 +102,17 @@ impl Lattice {
         spec: GridSpec,
         adaptivity: f64,
     ) -> Result<(KeyedMesh, MeshingStats)> {
+        self.mesh_keyed_in(spec, None, adaptivity)
+    }
+
+    /// [`Lattice::mesh_keyed`] on the blocks covering `region` only (a tile), or on the whole
+    /// padded grid.
+    pub(crate) fn mesh_keyed_in(
+        &self,
+        spec: GridSpec,
+        region: Option<IndexBox>,
+        adaptivity: f64,
+    ) -> Result<(KeyedMesh, MeshingStats)> {
         use std::time::Instant;
         let tpms = self
             .field(spec.half_width * spec.voxel)
@@ -96,7 +122,10 @@ impl Lattice {
             b: self.bounds,
         };
         let t = Instant::now();
-        let grid = Grid::sample(&solid, spec)?;
+        let grid = match region {
+            Some(r) => Grid::sample_box(&solid, spec, r)?,
+            None => Grid::sample(&solid, spec)?,
+        };
         let sample_seconds = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let mut keyed = if adaptivity == 0.0 {
