@@ -69,17 +69,18 @@ fn main() {
             .map(|r| r.parse().expect("--res 32,64"))
             .collect()
     });
+    let large: u32 = opt("--large").map_or(8, |s| s.parse().expect("--large N"));
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
-        "gyroid net, density {DENSITY}, {cells}x{cells}x{cells} cells of {CELL} mm; {threads} threads; {runs} runs per case (fresh process each), medians; load average at start: {}",
+        "gyroid net, density {DENSITY}, cells of {CELL} mm; {threads} threads; {runs} runs per case (fresh process each), medians; load average at start: {}",
         load_average()
     );
     let exe = std::env::current_exe().expect("own path");
-    let spawn = |case: &str, res: u32, level: f64, check: bool| -> Value {
+    let spawn = |case: &str, cells: u32, res: u32, level: f64, mode: &str| -> Value {
         let out = Command::new(&exe)
             .args(["--child", case, &res.to_string(), &cells.to_string()])
             .arg(format!("{:016x}", level.to_bits()))
-            .arg(if check { "check" } else { "time" })
+            .arg(mode)
             .stderr(std::process::Stdio::inherit())
             .output()
             .expect("spawn the bench binary");
@@ -88,35 +89,51 @@ fn main() {
         serde_json::from_str(line.trim()).expect("one JSON line from the child")
     };
 
-    let idle = spawn("idle", 32, 0.0, false);
+    let idle = spawn("idle", 1, 32, 0.0, "time");
     println!(
         "a child that does nothing: peak RSS {:.0} MB (included in every figure below)",
         idle["hwm_mb"].as_f64().unwrap()
     );
+    // The comparison at three resolutions; then a larger part at the lowest one, where latvox
+    // copies cells from a meshed template (CGAL's checks skipped for the peer's big mesh).
+    let mut parts: Vec<(u32, u32, &[&str], &str)> = resolutions
+        .iter()
+        .map(|&r| (cells, r, &CASES[..], "check"))
+        .collect();
+    if large > 0 {
+        parts.push((large, resolutions[0], &CASES[..3], "check-quick"));
+    }
     let mut rows = Vec::new();
-    for &res in &resolutions {
+    for (cells, res, cases, check) in parts {
         let voxel = CELL / res as f64;
-        let counts = [cells as f64; 3];
         let cal = calibrate::calibrate(
             Surface::Gyroid,
             Structure::Net,
             DENSITY,
             [CELL; 3],
             voxel,
-            counts,
+            [cells as f64; 3],
             0.0,
         )
         .expect("calibration");
         let n = cells as i64 * res as i64 + 2 * PAD;
         println!(
-            "\n{res} voxels per cell: level t = {:.6}; dense array {n}^3 = {:.1} M samples ({:.0} MB as f32)",
+            "\n{cells}x{cells}x{cells} cells, {res} voxels per cell: level t = {:.6}; dense array {n}^3 = {:.1} M samples ({:.0} MB as f32)",
             cal.level,
             (n * n * n) as f64 / 1e6,
             (n * n * n * 4) as f64 / 1e6
         );
-        for case in CASES {
+        for &case in cases {
             let results: Vec<Value> = (0..runs)
-                .map(|r| spawn(case, res, cal.level, r == 0))
+                .map(|r| {
+                    spawn(
+                        case,
+                        cells,
+                        res,
+                        cal.level,
+                        if r == 0 { check } else { "time" },
+                    )
+                })
                 .collect();
             let med = |key: &str| {
                 let v: Vec<f64> = results.iter().filter_map(|r| r[key].as_f64()).collect();
@@ -124,7 +141,7 @@ fn main() {
             };
             let first = &results[0];
             let row = json!({
-                "res": res,
+                "part": format!("{cells}³ × {res}"),
                 "case": case,
                 "wall": med("wall"),
                 "cpu": med("cpu"),
@@ -136,6 +153,7 @@ fn main() {
                 "check": first["check"],
                 "stages": first["stages"],
                 "job_checks": first["job_checks"],
+                "instanced": first["instanced"],
                 "level": first["level"],
             });
             if case == "latvox job" {
@@ -155,7 +173,8 @@ fn child(a: &[String]) {
     let res: u32 = a[1].parse().unwrap();
     let cells: u32 = a[2].parse().unwrap();
     let level = f64::from_bits(u64::from_str_radix(&a[3], 16).unwrap());
-    let check = a[4] == "check";
+    let check = a[4].starts_with("check");
+    let cgal = a[4] == "check";
     // Start rayon's pool before the clock, for every case alike.
     let _: u64 = (0..1000u64).into_par_iter().sum();
 
@@ -203,7 +222,7 @@ fn child(a: &[String]) {
             out.insert("level".into(), json!(report.level));
             out.insert("stages".into(), json!(report.timings));
             out.insert("job_checks".into(), json!(report.checks));
-            out.insert("route".into(), json!(report.instancing.is_some()));
+            out.insert("instanced".into(), json!(report.instancing));
             None
         }
         "latvox mesh" => {
@@ -255,7 +274,7 @@ fn child(a: &[String]) {
             b: bounds,
         };
         // The job's own report holds CGAL's checks of the mesh it wrote.
-        let cgal = case != "latvox job";
+        let cgal = cgal && case != "latvox job";
         out.insert(
             "check".into(),
             check_mesh(&m, &surface, voxel, bounds.volume(), cgal),
@@ -556,6 +575,9 @@ fn print_row(r: &Value) {
         r["hwm_mb"].as_f64().unwrap(),
         r["triangles"]
     );
+    if !r["instanced"].is_null() {
+        println!("      instanced: {}", r["instanced"]);
+    }
     if !r["stages"].is_null() {
         println!("      job stages (s): {}", r["stages"]);
         println!("      job's own CGAL checks: {}", r["job_checks"]);
@@ -566,12 +588,12 @@ fn print_row(r: &Value) {
 /// The README tables: speed and memory (absolute, and against latvox's sample + mesh), then what
 /// each mesh is.
 fn print_table(rows: &[Value]) {
-    println!("\n| vox/cell | mesher | wall (sample + mesh) | ÷ latvox mesh | CPU | peak RSS | ÷ latvox mesh | triangles |");
+    println!("\n| cells × vox/cell | mesher | wall (sample + mesh) | ÷ latvox mesh | CPU | peak RSS | ÷ latvox mesh | triangles |");
     println!("|---|---|---|---|---|---|---|---|");
     for r in rows {
         let base = rows
             .iter()
-            .find(|b| b["res"] == r["res"] && b["case"] == "latvox mesh")
+            .find(|b| b["part"] == r["part"] && b["case"] == "latvox mesh")
             .unwrap();
         let wall = r["wall"].as_f64().unwrap();
         let hwm = r["hwm_mb"].as_f64().unwrap();
@@ -582,7 +604,7 @@ fn print_table(rows: &[Value]) {
         };
         println!(
             "| {} | {} | {wall:.3} s{parts} | {:.2} | {:.3} s | {hwm:.0} MB | {:.2} | {} |",
-            r["res"],
+            r["part"].as_str().unwrap(),
             r["case"].as_str().unwrap(),
             wall / base["wall"].as_f64().unwrap(),
             r["cpu"].as_f64().unwrap(),
@@ -603,13 +625,18 @@ fn print_table(rows: &[Value]) {
             yes(!g["self_intersecting"].as_bool().unwrap())
         )
     };
-    println!("\n| vox/cell | mesher | boundary / non-manifold edges, exact weld | within {NEAR_WELD} mm | CGAL: closed, manifold, outward, no self-intersection | volume fraction | vertex to surface (voxels): median / 99th pct. / max |");
+    println!("\n| cells × vox/cell | mesher | boundary / non-manifold edges, exact weld | within {NEAR_WELD} mm | CGAL: closed, manifold, outward, no self-intersection | volume fraction | vertex to surface (voxels): median / 99th pct. / max |");
     println!("|---|---|---|---|---|---|---|");
     for r in rows {
         let c = &r["check"];
         let n = &c["near_weld"];
         let cgal = if r["case"] == "latvox job" {
-            verdict(&r["job_checks"])
+            let on = if r["instanced"].is_null() {
+                ""
+            } else {
+                " (on the template)"
+            };
+            format!("{}{on}", verdict(&r["job_checks"]))
         } else if n["cgal"].is_null() {
             verdict(&c["cgal"])
         } else {
@@ -620,8 +647,8 @@ fn print_table(rows: &[Value]) {
             )
         };
         println!(
-            "| {} | {} | {} / {} | {} / {} | {cgal} | {:.5} | {:.1e} / {:.3} / {:.3} |",
-            r["res"],
+            "| {} | {} | {} / {} | {} / {} | {cgal} | {:.5} | {:.1e} / {:.1e} / {:.3} |",
+            r["part"].as_str().unwrap(),
             r["case"].as_str().unwrap(),
             c["boundary"],
             c["non_manifold"],
