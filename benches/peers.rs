@@ -5,6 +5,8 @@
 //! `min + (i + ½)·h` with `h = 5 mm / resolution`, for 32, 64 and 128 voxels per cell. Every
 //! mesher meshes the same values: latvox's `TpmsField ∩ Aabb` (first-order distance to the
 //! gyroid, `max`-ed with the box's exact distance, so the solid is closed at the cut faces).
+//! Then a larger part, 8×8×8 cells at 32 voxels per cell (`--large N`, 0 to skip), where
+//! latvox's job copies cells from a meshed 3×3×3-cell template.
 //!
 //! - `latvox job`: the whole `latvox tpms` path in-process ([`TpmsJob::run_into`]): calibrate,
 //!   sample the narrow band, OpenVDB volumeToMesh, snap, CGAL's checks (self-intersection
@@ -13,8 +15,8 @@
 //!   field's clearance, sampled with rayon), OpenVDB volumeToMesh, snapping onto the surface and
 //!   the box's edges; an indexed mesh in memory.
 //! - `fast-surface-nets` and `mcubes`: they mesh a dense array. It is sampled by the same
-//!   `Field::sample_block` code latvox uses (8³ blocks, rayon over z-slabs) on the box plus one
-//!   sample outside each face (positive there, so their surfaces close too); its time is given
+//!   `Field::sample_block` code latvox uses (8³ blocks, rayon over z-slabs) on the box plus two
+//!   samples outside each face (positive there, so their surfaces close too); its time is given
 //!   apart ("sample") from the crate's own ("mesh": the crate call plus turning its output into
 //!   an indexed mesh in millimetres, with no welding). Both crates mesh on one thread.
 //!
@@ -24,11 +26,12 @@
 //! each case also checks the mesh, untimed: vertices welded exactly (bit-identical f32
 //! coordinates), then every edge counted here — boundary edges (one triangle), non-manifold
 //! edges (three or more), edges whose two triangles run the same way — degenerate triangles
-//! (a repeated welded vertex), the enclosed volume; and CGAL's checks (`latvox::verify`, with
-//! the self-intersection test) on the welded mesh. The job's mesh is checked as written: its
-//! STL file is read back here.
+//! (a repeated welded vertex), the enclosed volume, each vertex's distance to the exact surface;
+//! the edges again after welding within [`NEAR_WELD`]; and CGAL's checks (`latvox::verify`, with
+//! the self-intersection test) on the welded mesh (not on the larger part's meshes). The job's
+//! mesh is checked as written: its STL file is read back here; its CGAL checks are its own.
 //!
-//! Run: `cargo bench --bench peers` (`-- --runs N --res 32,64 --cells N`).
+//! Run: `cargo bench --bench peers` (`-- --runs N --res 32,64 --cells N --large N`).
 
 use latvox::field::{Field, Intersection};
 use latvox::grid::GridSpec;
@@ -151,7 +154,7 @@ fn main() {
                 "hwm_mb": med("hwm_mb"),
                 "triangles": first["triangles"],
                 "check": first["check"],
-                "stages": first["stages"],
+                "stages": median_stages(&results),
                 "job_checks": first["job_checks"],
                 "instanced": first["instanced"],
                 "level": first["level"],
@@ -557,6 +560,21 @@ fn load_average() -> String {
         .unwrap_or_default()
 }
 
+/// The job's stage times, each the median over the runs.
+fn median_stages(results: &[Value]) -> Value {
+    let Some(first) = results[0]["stages"].as_object() else {
+        return Value::Null;
+    };
+    let stages = first.keys().map(|k| {
+        let v = results
+            .iter()
+            .map(|r| r["stages"][k].as_f64().unwrap())
+            .collect();
+        (k.clone(), json!(median(v)))
+    });
+    Value::Object(stages.collect())
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
     v[v.len() / 2]
@@ -579,7 +597,7 @@ fn print_row(r: &Value) {
         println!("      instanced: {}", r["instanced"]);
     }
     if !r["stages"].is_null() {
-        println!("      job stages (s): {}", r["stages"]);
+        println!("      job stages, medians (s): {}", r["stages"]);
         println!("      job's own CGAL checks: {}", r["job_checks"]);
     }
     println!("      check: {}", r["check"]);
