@@ -1,0 +1,100 @@
+//! The feasible ranges latvox refuses densities by are right at both ends: the tabulated ranges
+//! (`calibrate::PERCOLATION`) are recomputed here at each end by an independent percolation test
+//! of the sampled unit cell (union-find over a periodic 2×2×2 block), and the command line refuses
+//! a density just outside the solid's range with the range in its one-line message.
+
+use latvox::tpms::calibrate::{analytic_level, connectivity_sampled, PERCOLATION};
+use latvox::tpms::{Structure, Surface};
+use std::process::Command;
+
+/// How far inside / outside an end the test looks, in volume fraction.
+const STEP: f64 = 0.004;
+
+fn phase_connected(surface: Surface, structure: Structure, vf: f64, void: bool, n: usize) -> bool {
+    let c = connectivity_sampled(
+        surface,
+        structure,
+        analytic_level(surface, structure, vf),
+        n,
+    );
+    if void {
+        c.void
+    } else {
+        c.solid
+    }
+}
+
+#[test]
+fn every_tabulated_range_end_is_where_percolation_changes() {
+    let mut failures = Vec::new();
+    let mut ends = 0;
+    for (surface, structure, solid, void) in PERCOLATION {
+        for (range, is_void) in [(solid, false), (void, true)] {
+            // An end at 0 or 1 is the end of the fraction range itself, not a percolation limit.
+            for (end, inward) in [(range.min, 1.0), (range.max, -1.0)] {
+                if end <= 0.0 || end >= 1.0 {
+                    continue;
+                }
+                ends += 1;
+                let inside = end + inward * STEP;
+                let outside = end - inward * STEP;
+                // Ends below 0.12 are thin-strut limits, resolved at 128 samples per cell.
+                let n = if end < 0.12 { 128 } else { 64 };
+                let (a, b) = (
+                    phase_connected(surface, structure, inside, is_void, n),
+                    phase_connected(surface, structure, outside, is_void, n),
+                );
+                let what = if is_void { "void" } else { "solid" };
+                eprintln!(
+                    "{:8} {:6} {what:5} end {end:.4}: connected at {inside:.4} {a}, at {outside:.4} {b}",
+                    surface.name(),
+                    structure.name()
+                );
+                if !a || b {
+                    failures.push(format!(
+                        "{surface:?} {structure:?} {what} end {end}: connected {a} at {inside}, {b} at {outside}"
+                    ));
+                }
+            }
+        }
+    }
+    assert!(ends >= 14, "only {ends} ends tested");
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn a_density_outside_the_solid_range_is_refused_with_the_range() {
+    let dir = tempfile::tempdir().unwrap();
+    for (surface, structure, solid, _) in PERCOLATION {
+        for (end, outward) in [(solid.min, -1.0), (solid.max, 1.0)] {
+            if end <= 0.0 || end >= 1.0 {
+                continue;
+            }
+            let density = format!("{:.4}", end + outward * STEP);
+            let out = dir.path().join("x.stl");
+            let o = Command::new(env!("CARGO_BIN_EXE_latvox"))
+                .args(["tpms", "--type", surface.name(), "--structure"])
+                .args([
+                    structure.name(),
+                    "--density",
+                    &density,
+                    "--cells",
+                    "1",
+                    "-o",
+                ])
+                .arg(&out)
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(
+                o.status.code(),
+                Some(2),
+                "{surface:?} {structure:?} {density}: {err}"
+            );
+            let range = format!("{:.3} to {:.3}", solid.min, solid.max);
+            assert!(err.contains(&range), "message lacks {range}: {err}");
+            assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+            assert!(!out.exists());
+        }
+    }
+}
