@@ -3,7 +3,9 @@
 //! 1. The main job at scale: 10×10×10 gyroid cells, net, density 0.30, 32 voxels per cell (a
 //!    320³ grid), run as the `latvox` binary writing its STL: wall time and peak resident memory
 //!    (the child's own `ru_maxrss`, from wait4), median of several runs.
-//! 2. Calibration alone, for every type and structure at density 0.30, in a fresh process each
+//! 2. Scale: 10³ and 30³ gyroid cells at 16 voxels per cell, instanced (STL and 3MF), meshed
+//!    whole, and in tiles of a small memory budget: wall time and peak resident memory.
+//! 3. Calibration alone, for every type and structure at density 0.30, in a fresh process each
 //!    (so the per-process sample tables are built inside the timing, as a CLI run pays them).
 //!
 //! Run: `cargo bench --bench tpms` (add `-- --runs N` to change the repeat count).
@@ -108,9 +110,60 @@ fn main() {
         println!("  stage times of the last run (s): {}", rep["timings"]);
     }
 
+    println!("scale: gyroid net 0.30, 16 voxels per cell, 5 mm cells, STL or 3MF written:");
+    for (label, cells, extra) in [
+        ("10x10x10 cells, instanced, STL", "10", vec![]),
+        ("30x30x30 cells, instanced, STL", "30", vec![]),
+        ("30x30x30 cells, instanced, 3MF", "30", vec!["3mf"]),
+        (
+            "10x10x10 cells, whole part meshed at once",
+            "10",
+            vec!["--no-instancing"],
+        ),
+        (
+            "10x10x10 cells, tiles for a 64 MB budget",
+            "10",
+            vec!["--no-instancing", "--memory", "64M"],
+        ),
+    ] {
+        let mut walls = Vec::new();
+        let mut rss = Vec::new();
+        let ext = if extra.first() == Some(&"3mf") {
+            "3mf"
+        } else {
+            "stl"
+        };
+        let out = dir.path().join(format!("s.{ext}"));
+        let report = dir.path().join("s.json");
+        for _ in 0..runs {
+            let mut c = Command::new(exe);
+            c.args(["tpms", "-t", "gyroid", "-d", "0.3", "--cells", cells])
+                .args(["--cell-size", "5", "--resolution", "16", "--quiet"])
+                .arg("-o")
+                .arg(&out)
+                .arg("--report")
+                .arg(&report)
+                .args(extra.iter().filter(|a| **a != "3mf"))
+                .stdout(std::process::Stdio::null());
+            let (s, m, code) = run_measured(&mut c);
+            assert_eq!(code, 0, "latvox failed on {label}");
+            walls.push(s);
+            rss.push(m);
+        }
+        let rep: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        println!(
+            "  {label}: wall {:.2} s, peak RSS {:.0} MB (medians); {} triangles, file {:.0} MB, achieved density {:.5}",
+            median(walls),
+            median(rss),
+            rep["triangles"],
+            std::fs::metadata(&out).unwrap().len() as f64 / 1e6,
+            rep["achieved_density"].as_f64().unwrap()
+        );
+        let _ = std::fs::remove_file(&out);
+    }
+
     println!("calibration alone (density 0.30, 32 voxels per cell, 3x3x3 cells, fresh process):");
-    let probe = std::path::Path::new(exe).with_file_name("latvox");
-    let _ = probe;
     for t in ["p", "gyroid", "d", "iwp", "s", "frd", "neovius"] {
         for st in ["net", "sheet"] {
             let mut cal = Vec::new();

@@ -131,7 +131,10 @@ impl KeyedMesh {
                 let p = q.map(|v| pos[v as usize]);
                 let ac = quality(p[0], p[1], p[2]).min(quality(p[0], p[2], p[3]));
                 let bd_q = quality(p[0], p[1], p[3]).min(quality(p[1], p[2], p[3]));
-                *bd = bd_q > ac;
+                // A tie (a symmetric quad, often on a flat cut face) keeps the first diagonal:
+                // the copies of a cell, whose coordinates differ in their last bits, then
+                // choose alike.
+                *bd = bd_q > ac * (1.0 + 1e-9);
             });
     }
 

@@ -70,6 +70,18 @@ impl Aabb {
         let s = self.size();
         s[0] * s[1] * s[2]
     }
+
+    pub fn contains(&self, p: Vec3) -> bool {
+        (0..3).all(|a| p[a] >= self.min[a] && p[a] <= self.max[a])
+    }
+
+    /// The box grown by `m` on every side.
+    pub fn grown(&self, m: f64) -> Aabb {
+        Aabb {
+            min: self.min.map(|x| x - m),
+            max: self.max.map(|x| x + m),
+        }
+    }
 }
 
 impl Field for Aabb {

@@ -179,6 +179,23 @@ fn xy_moments(poly: &[Vec3]) -> (f64, f64) {
 }
 
 fn clipped_column_integral(tri: [Vec3; 3], b: &Aabb) -> f64 {
+    let lo = |a: usize| tri[0][a].min(tri[1][a]).min(tri[2][a]);
+    let hi = |a: usize| tri[0][a].max(tri[1][a]).max(tri[2][a]);
+    // Most triangles need no clipping: wholly beside the box's columns, or wholly within them
+    // and below, inside or above the box.
+    if (0..2).any(|a| hi(a) <= b.min[a] || lo(a) >= b.max[a]) || hi(2) <= b.min[2] {
+        return 0.0;
+    }
+    let (z0, z1) = (b.min[2], b.max[2]);
+    if (0..2).all(|a| lo(a) >= b.min[a] && hi(a) <= b.max[a]) {
+        if lo(2) >= z1 {
+            return (z1 - z0) * xy_moments(&tri).0;
+        }
+        if lo(2) >= z0 && hi(2) <= z1 {
+            let (a, zint) = xy_moments(&tri);
+            return zint - z0 * a;
+        }
+    }
     let mut poly = tri.to_vec();
     let mut tmp = Vec::with_capacity(8);
     for (axis, c, s) in [
@@ -193,7 +210,6 @@ fn clipped_column_integral(tri: [Vec3; 3], b: &Aabb) -> f64 {
             return 0.0;
         }
     }
-    let (z0, z1) = (b.min[2], b.max[2]);
     // Part between the two planes contributes ∫(z − z0); part above contributes (z1 − z0)·A.
     let mut mid = Vec::with_capacity(8);
     clip_polygon(&poly, 2, z1, 1.0, &mut tmp);

@@ -269,3 +269,156 @@ impl MeshSink for MeshCollector {
         Ok(())
     }
 }
+
+/// Streams a 3MF package: corners are welded exactly as they arrive (one index per distinct
+/// vertex is all that is held in memory), vertex and triangle records go to two temporary files
+/// beside `path`, and [`ThreeMfSink::commit`] zips them into the model XML and renames the
+/// package into place.
+pub struct ThreeMfSink {
+    path: PathBuf,
+    vertices: std::io::BufWriter<std::fs::File>,
+    triangles: std::io::BufWriter<std::fs::File>,
+    index: HashMap<[u32; 3], u32>,
+}
+
+impl ThreeMfSink {
+    /// Opens the temporary files (the destination folder must be writable).
+    pub fn create(path: &Path) -> Result<ThreeMfSink> {
+        let scratch = || {
+            let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
+            tempfile::tempfile_in(dir.unwrap_or(Path::new(".")))
+                .map(|f| std::io::BufWriter::with_capacity(1 << 20, f))
+                .map_err(|e| Error::io(path, e))
+        };
+        Ok(ThreeMfSink {
+            path: path.to_path_buf(),
+            vertices: scratch()?,
+            triangles: scratch()?,
+            index: HashMap::new(),
+        })
+    }
+
+    /// Zips the records into the package and moves it into place.
+    pub fn commit(self) -> Result<()> {
+        use crate::io::threemf;
+        use std::io::{Seek, SeekFrom};
+        let path = self.path.clone();
+        let io = |e: std::io::Error| Error::io(&path, e);
+        let zerr = |e: zip::result::ZipError| Error::io(&path, std::io::Error::other(e));
+        let rewound = |w: std::io::BufWriter<std::fs::File>| -> std::io::Result<std::fs::File> {
+            let mut f = w.into_inner().map_err(|e| e.into_error())?;
+            f.seek(SeekFrom::Start(0))?;
+            Ok(f)
+        };
+        let (mut v, mut t) = (
+            rewound(self.vertices).map_err(io)?,
+            rewound(self.triangles).map_err(io)?,
+        );
+        let body = v.metadata().map_err(io)?.len() + t.metadata().map_err(io)?.len();
+        let tmp = crate::output::temp_beside(&path)?;
+        let file = std::io::BufWriter::with_capacity(1 << 20, tmp.reopen().map_err(io)?);
+        let mut zip = zip::ZipWriter::new(file);
+        let opts = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Deflated);
+        zip.start_file("[Content_Types].xml", opts).map_err(zerr)?;
+        zip.write_all(threemf::CONTENT_TYPES).map_err(io)?;
+        zip.start_file("_rels/.rels", opts).map_err(zerr)?;
+        zip.write_all(threemf::rels().as_bytes()).map_err(io)?;
+        // Zip64 once the model could pass 4 GiB.
+        let large = body + 4096 >= u32::MAX as u64;
+        zip.start_file("3D/3dmodel.model", opts.large_file(large))
+            .map_err(zerr)?;
+        zip.write_all(threemf::model_head().as_bytes())
+            .map_err(io)?;
+        std::io::copy(&mut v, &mut zip).map_err(io)?;
+        zip.write_all(threemf::MODEL_MIDDLE.as_bytes())
+            .map_err(io)?;
+        std::io::copy(&mut t, &mut zip).map_err(io)?;
+        zip.write_all(threemf::MODEL_TAIL.as_bytes()).map_err(io)?;
+        let mut file = zip.finish().map_err(zerr)?;
+        file.flush().map_err(io)?;
+        drop(file);
+        tmp.persist(&path).map_err(|e| Error::io(&path, e.error))?;
+        Ok(())
+    }
+}
+
+impl MeshSink for ThreeMfSink {
+    fn begin(&mut self, _triangles: Option<u64>) -> Result<()> {
+        Ok(())
+    }
+
+    fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
+        use crate::io::threemf::{triangle_line, vertex_line};
+        for t in batch {
+            let mut ids = [0u32; 3];
+            for (id, p) in ids.iter_mut().zip(t) {
+                let key = p.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
+                let next = self.index.len() as u32;
+                *id = *self.index.entry(key).or_insert(next);
+                if *id == next {
+                    vertex_line(&mut self.vertices, p).map_err(|e| Error::io(&self.path, e))?;
+                }
+            }
+            if ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] {
+                return Err(Error::invalid(
+                    "3MF forbids degenerate triangles and the mesh has one (write STL instead)",
+                ));
+            }
+            triangle_line(&mut self.triangles, &ids).map_err(|e| Error::io(&self.path, e))?;
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self) -> Result<()> {
+        Ok(())
+    }
+}
+
+/// The part's file: STL or 3MF, chosen by the output's extension.
+pub enum FileSink {
+    Stl(StlSink),
+    ThreeMf(ThreeMfSink),
+}
+
+impl FileSink {
+    /// A 3MF package when `path` ends in `.3mf`, otherwise STL in `stl`'s format.
+    pub fn create(path: &Path, stl: StlFormat) -> Result<FileSink> {
+        let is_3mf = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("3mf"));
+        Ok(if is_3mf {
+            FileSink::ThreeMf(ThreeMfSink::create(path)?)
+        } else {
+            FileSink::Stl(StlSink::create(path, stl)?)
+        })
+    }
+
+    pub fn commit(self) -> Result<()> {
+        match self {
+            FileSink::Stl(s) => s.commit(),
+            FileSink::ThreeMf(s) => s.commit(),
+        }
+    }
+
+    fn inner(&mut self) -> &mut dyn MeshSink {
+        match self {
+            FileSink::Stl(s) => s,
+            FileSink::ThreeMf(s) => s,
+        }
+    }
+}
+
+impl MeshSink for FileSink {
+    fn begin(&mut self, triangles: Option<u64>) -> Result<()> {
+        self.inner().begin(triangles)
+    }
+
+    fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
+        self.inner().triangles(batch)
+    }
+
+    fn finish(&mut self) -> Result<()> {
+        self.inner().finish()
+    }
+}

@@ -61,11 +61,26 @@ enum Outcome {
 
 /// Snaps the vertices of `mesh`, extracted from `surface ∩ clip` sampled on `spec`.
 pub fn snap(mesh: &mut KeyedMesh, surface: &dyn Field, clip: &Aabb, spec: &GridSpec) -> SnapStats {
+    snap_within(mesh, surface, clip, spec, None)
+}
+
+/// [`snap`], leaving where OpenVDB put them the vertices outside `within` (when only part of
+/// the mesh is measured).
+pub fn snap_within(
+    mesh: &mut KeyedMesh,
+    surface: &dyn Field,
+    clip: &Aabb,
+    spec: &GridSpec,
+    within: Option<&Aabb>,
+) -> SnapStats {
     let outcomes: Vec<Outcome> = mesh
         .positions
         .par_iter_mut()
         .zip(mesh.keys.par_iter())
         .map(|(p, k)| {
+            if within.is_some_and(|b| !b.contains(*p)) {
+                return Outcome::Untouched;
+            }
             let (out, w) = snap_vertex(*p, k.voxel, surface, clip, spec);
             if let Some(w) = w {
                 *p = w;

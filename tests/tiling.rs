@@ -128,3 +128,64 @@ fn a_small_memory_budget_tiles_the_part() {
     let bad = run(&["tpms", "--tile", "20", "-o", "x.stl"], dir.path());
     assert_eq!(bad.status.code(), Some(2));
 }
+
+/// trimesh (PyPI) on a mesh file: faces, watertight, volume.
+fn trimesh_summary(path: &std::path::Path) -> (u64, bool, f64) {
+    let o = std::process::Command::new("python3")
+        .args([
+            "-c",
+            "import sys, warnings; warnings.filterwarnings('ignore'); import trimesh; \
+             m = trimesh.load(sys.argv[1], force='mesh'); \
+             print(len(m.faces), int(m.is_watertight), repr(float(m.volume)))",
+        ])
+        .arg(path)
+        .output()
+        .expect("python3 with trimesh (scripts/install-deps.sh installs it)");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = String::from_utf8(o.stdout).unwrap();
+    let f: Vec<&str> = s.split_whitespace().collect();
+    (f[0].parse().unwrap(), f[1] == "1", f[2].parse().unwrap())
+}
+
+#[test]
+fn a_streamed_3mf_holds_the_same_solid_as_the_stl() {
+    let dir = tempdir();
+    for (route, extra) in [
+        ("instanced", vec![]),
+        ("tiled", vec!["--no-instancing", "--tile", "32"]),
+    ] {
+        for out in ["p.stl", "p.3mf"] {
+            let mut args = vec![
+                "tpms", "-t", "gyroid", "-d", "0.3", "--cells", "4", "-r", "16",
+            ];
+            args.extend(&extra);
+            args.extend(["-q", "-o", out]);
+            let o = run(&args, dir.path());
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(0), "{route} {out}: {err}");
+        }
+        let (stl, tmf) = (dir.path().join("p.stl"), dir.path().join("p.3mf"));
+        let tris = read_stl(&stl);
+        let v = volume(&tris);
+        // An independent reader: trimesh loads the package, welds nothing it need not.
+        let (faces, watertight, vol) = trimesh_summary(&tmf);
+        assert_eq!(faces as usize, tris.len(), "{route}: triangle count");
+        assert!(watertight, "{route}: trimesh finds the 3MF open");
+        assert!(((vol - v) / v).abs() < 1e-6, "{route}: volume {vol} vs {v}");
+        // latvox's own checker, CGAL included, on the package.
+        let o = run(&["check", "p.3mf"], dir.path());
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{route}: {}",
+            String::from_utf8_lossy(&o.stdout)
+        );
+        // Nothing left beside the outputs: the scratch files were anonymous.
+        let mut names: Vec<String> = files_in(dir.path())
+            .iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["p.3mf", "p.stl"], "{route}");
+    }
+}

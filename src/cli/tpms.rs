@@ -22,6 +22,14 @@ Examples:
   # A 50×30×10 mm block filled with 10 mm Schwarz-P cells (partial cells at the far sides)
   latvox tpms --type p --density 0.35 --size 50,30,10 --cell-size 10 -o p-block.stl
 
+  # 30×30×30 cells (27,000) as a 3MF package: periodic cells are copies of a meshed template,
+  # streamed to the file; memory stays flat whatever the cell count
+  latvox tpms --type gyroid --density 0.3 --cells 30 --cell-size 5 --resolution 16 -o big.3mf
+
+  # The whole part meshed in tiles that fit a 1 GB budget, streamed to the file (the path
+  # taken when cells cannot be copied: a box that ends inside a voxel, or --no-instancing)
+  latvox tpms --type d --density 0.25 --cells 20 --cell-size 6 --no-instancing --memory 1G -o d.stl
+
 Types: p (Schwarz primitive), g|gyroid, d (Schwarz diamond), iwp (Schoen I-WP),
        s (Fischer–Koch S), frd (Schoen F-RD), n|neovius.
 Structures: net (solid on one side of F = t), sheet (solid where |F| ≤ t).
@@ -57,11 +65,12 @@ pub struct TpmsArgs {
     /// OpenVDB mesh adaptivity: 0 keeps uniform triangles, up to 1 merges flat regions.
     #[arg(long, default_value_t = 0.0, value_parser = parse_unit)]
     pub adaptivity: f64,
-    /// Output mesh (binary STL unless --ascii).
+    /// Output mesh: binary STL (ASCII with --ascii), or a 3MF package when the name ends in
+    /// .3mf; streamed to the file as it is made.
     #[arg(
         long,
         short = 'o',
-        value_name = "FILE.stl",
+        value_name = "FILE.stl|FILE.3mf",
         default_value = "lattice.stl"
     )]
     pub output: PathBuf,
@@ -139,7 +148,7 @@ pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
     Ok(if passed(&report) { 0 } else { 1 })
 }
 
-/// Runs the job and writes its STL atomically; returns the report (output and write time
+/// Runs the job and writes its mesh atomically; returns the report (output and write time
 /// filled in), for `run` to print and `latvox batch` to record.
 pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<TpmsReport> {
     let job = TpmsJob {
@@ -163,7 +172,7 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
         StlFormat::Binary
     };
     // The part streams into a temporary file that becomes the output only once the job is done.
-    let mut sink = latvox::sink::StlSink::create(&a.output, format)?;
+    let mut sink = latvox::sink::FileSink::create(&a.output, format)?;
     let mut report = job.run_into(progress, &mut sink)?;
     sink.commit()?;
     report.output = Some(a.output.display().to_string());

@@ -279,6 +279,39 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
 }
 
 /// Writes a 3MF package with one mesh object and one build item.
+/// The package's fixed parts, and the model XML up to its first vertex / after its last triangle.
+pub(crate) const CONTENT_TYPES: &[u8] = br#"<?xml version="1.0" encoding="UTF-8"?>
+<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types"><Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/><Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/></Types>
+"#;
+
+pub(crate) fn rels() -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="{REL_3DMODEL}"/></Relationships>
+"#
+    )
+}
+
+pub(crate) fn model_head() -> String {
+    format!("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" xml:lang=\"en-US\" xmlns=\"{MODEL_NS}\">\n<metadata name=\"Application\">latvox</metadata>\n<resources>\n<object id=\"1\" type=\"model\">\n<mesh>\n<vertices>\n")
+}
+
+pub(crate) const MODEL_MIDDLE: &str = "</vertices>\n<triangles>\n";
+pub(crate) const MODEL_TAIL: &str =
+    "</triangles>\n</mesh>\n</object>\n</resources>\n<build>\n<item objectid=\"1\"/>\n</build>\n</model>\n";
+
+pub(crate) fn vertex_line(w: &mut dyn Write, p: &[f32]) -> std::io::Result<()> {
+    writeln!(w, "<vertex x=\"{}\" y=\"{}\" z=\"{}\"/>", p[0], p[1], p[2])
+}
+
+pub(crate) fn triangle_line(w: &mut dyn Write, t: &[u32]) -> std::io::Result<()> {
+    writeln!(
+        w,
+        "<triangle v1=\"{}\" v2=\"{}\" v3=\"{}\"/>",
+        t[0], t[1], t[2]
+    )
+}
+
 pub fn write(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
     if let Some(t) = mesh
         .indices
@@ -295,40 +328,21 @@ pub fn write(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
         .compression_method(zip::CompressionMethod::Deflated);
     let z = |e: zip::result::ZipError| std::io::Error::other(e);
     zip.start_file("[Content_Types].xml", opts).map_err(z)?;
-    zip.write_all(
-        br#"<?xml version="1.0" encoding="UTF-8"?>
-<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types"><Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/><Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/></Types>
-"#,
-    )?;
+    zip.write_all(CONTENT_TYPES)?;
     zip.start_file("_rels/.rels", opts).map_err(z)?;
-    write!(
-        zip,
-        r#"<?xml version="1.0" encoding="UTF-8"?>
-<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="{REL_3DMODEL}"/></Relationships>
-"#
-    )?;
+    zip.write_all(rels().as_bytes())?;
     zip.start_file("3D/3dmodel.model", opts).map_err(z)?;
     {
         let mut x = std::io::BufWriter::with_capacity(1 << 16, &mut zip);
-        write!(
-            x,
-            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" xml:lang=\"en-US\" xmlns=\"{MODEL_NS}\">\n<metadata name=\"Application\">latvox</metadata>\n<resources>\n<object id=\"1\" type=\"model\">\n<mesh>\n<vertices>\n"
-        )?;
+        x.write_all(model_head().as_bytes())?;
         for p in mesh.positions.chunks_exact(3) {
-            writeln!(x, "<vertex x=\"{}\" y=\"{}\" z=\"{}\"/>", p[0], p[1], p[2])?;
+            vertex_line(&mut x, p)?;
         }
-        writeln!(x, "</vertices>\n<triangles>")?;
+        x.write_all(MODEL_MIDDLE.as_bytes())?;
         for t in mesh.indices.chunks_exact(3) {
-            writeln!(
-                x,
-                "<triangle v1=\"{}\" v2=\"{}\" v3=\"{}\"/>",
-                t[0], t[1], t[2]
-            )?;
+            triangle_line(&mut x, t)?;
         }
-        writeln!(
-            x,
-            "</triangles>\n</mesh>\n</object>\n</resources>\n<build>\n<item objectid=\"1\"/>\n</build>\n</model>"
-        )?;
+        x.write_all(MODEL_TAIL.as_bytes())?;
         x.flush()?;
     }
     let buf = zip.finish().map_err(z)?.into_inner();

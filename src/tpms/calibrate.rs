@@ -46,15 +46,10 @@ fn table(surface: Surface, structure: Structure) -> &'static Table {
     };
     TABLES[si][ki].get_or_init(|| {
         use rayon::prelude::*;
-        let samples: Vec<(f32, f32)> = (0..N * N * N)
+        let samples: Vec<(f32, f32)> = surface
+            .eval_cell_midpoints(N)
             .into_par_iter()
-            .map(|i| {
-                let u = [
-                    ((i / (N * N)) as f64 + 0.5) / N as f64,
-                    (((i / N) % N) as f64 + 0.5) / N as f64,
-                    ((i % N) as f64 + 0.5) / N as f64,
-                ];
-                let (f, g) = surface.eval(u);
+            .map(|(f, g)| {
                 let gn = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
                 // Within a tenth of a sample spacing of F = 0 (first order): on the mid-surface.
                 let near = f.abs() < gn * 0.1 / N as f64;
@@ -120,17 +115,10 @@ pub fn connectivity_sampled(
     t: f64,
     n: usize,
 ) -> Connectivity {
-    use rayon::prelude::*;
-    let vals: Vec<f64> = (0..n * n * n)
-        .into_par_iter()
-        .map(|i| {
-            let u = [
-                ((i / (n * n)) as f64 + 0.5) / n as f64,
-                (((i / n) % n) as f64 + 0.5) / n as f64,
-                ((i % n) as f64 + 0.5) / n as f64,
-            ];
-            surface.eval(u).0
-        })
+    let vals: Vec<f64> = surface
+        .eval_cell_midpoints(n)
+        .into_iter()
+        .map(|(f, _)| f)
         .collect();
     let one = |member: &(dyn Fn(f64) -> bool + Sync)| one_percolating_component(&vals, n, member);
     match structure {
@@ -316,7 +304,10 @@ pub fn calibrate(
         max: cell,
     };
     let cell_volume = cell_box.volume();
-    let m = MARGIN * voxel;
+    let m = std::env::var("XMARGIN")
+        .map(|v| v.parse::<f64>().unwrap())
+        .unwrap_or(MARGIN)
+        * voxel;
     let padded = Aabb {
         min: [-m; 3],
         max: [0, 1, 2].map(|a| cell[a] + m),
@@ -334,8 +325,7 @@ pub fn calibrate(
     let spec = GridSpec::covering(&padded, voxel, super::HALF_WIDTH);
     // What an interior cell contributes: the periodic cell's mesh measured inside the cell.
     let interior = |t: f64| -> Result<f64> {
-        let (periodic, _) = mk(t, padded).mesh_on(spec, adaptivity)?;
-        Ok(periodic.volume_in_box(&cell_box) / cell_volume)
+        Ok(mk(t, padded).volume_in(spec, adaptivity, &cell_box)? / cell_volume)
     };
 
     // Slope of the exact fraction at t0, for the first step.
@@ -371,6 +361,9 @@ pub fn calibrate(
         let ib = interior(tb)?;
         meshings += 1;
         let pb = predict(ib);
+        if std::env::var("XDBG").is_ok() {
+            eprintln!("{surface:?} {structure:?} t0 {t0:.5} p0 {:.5} ta {ta:.5} pa {pa:.6} tb {tb:.5} pb {pb:.6} A(tb) {:.6}", predict(0.0) , analytic_fraction(surface, structure, tb));
+        }
         let s = if (pb - pa).abs() > 1e-12 {
             (pb - pa) / (tb - ta)
         } else {

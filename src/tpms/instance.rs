@@ -20,8 +20,8 @@
 //! neighbouring cell whose kind differs from the template neighbour's, its corner is taken from
 //! the *twin* of the template vertex — the same key one cell over, inside the interior cell.
 //!
-//! Requirements: adaptivity 0 (OpenVDB's adaptive merging is not local), a whole number of voxels
-//! per cell along each copied axis, and cells of at least [`MIN_SAMPLES_PER_CELL`] voxels, so the
+//! Requirements: adaptivity 0 (OpenVDB's adaptive merging is not local), a whole number of
+//! OpenVDB leaves (8 voxels) per cell along each copied axis, and cells of at least [`MIN_SAMPLES_PER_CELL`] voxels, so the
 //! box's influence (narrow band, clipping, snapping) dies out well inside the first cell.
 //!
 //! [`TpmsField`]: super::TpmsField
@@ -37,6 +37,8 @@ use std::collections::HashMap;
 
 /// Fewest voxels per cell for instancing.
 pub const MIN_SAMPLES_PER_CELL: i64 = 16;
+/// OpenVDB's leaf edge, voxels: a copied cell spans a whole number of leaves.
+pub const BLOCK: u32 = 8;
 
 /// How one axis of the part maps onto the template.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -84,7 +86,10 @@ pub fn plan(size: Vec3, cell: Vec3, h: f64) -> Option<[AxisPlan; 3]> {
         let p = (cell[a] / h).round();
         let whole = (cell[a] / h - p).abs() < 1e-9 * p;
         let m = if partial { 4 } else { 3 };
-        if whole && p as i64 >= MIN_SAMPLES_PER_CELL && n > m {
+        // OpenVDB meshes leaf by leaf (8³ voxels) and settles ambiguous voxels at leaf borders
+        // its own way: a cell meshes alike wherever it is only if it spans whole leaves.
+        let aligned = p as i64 % BLOCK as i64 == 0;
+        if whole && aligned && p as i64 >= MIN_SAMPLES_PER_CELL && n > m {
             AxisPlan { n, m, p: p as i64 }
         } else {
             AxisPlan::WHOLE

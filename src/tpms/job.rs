@@ -202,10 +202,12 @@ impl TpmsJob {
                         self.density
                     )));
                 }
+                // Raised to whole 8-voxel blocks, so that cells can still be copied exactly.
+                let raised = needed.div_ceil(instance::BLOCK) * instance::BLOCK;
                 warnings.push(format!(
-                    "resolution raised from {resolution} to {needed} voxels per cell: sheet walls were {w:.2} voxels thin"
+                    "resolution raised from {resolution} to {raised} voxels per cell: sheet walls were {w:.2} voxels thin"
                 ));
-                resolution = needed;
+                resolution = raised;
             }
             wall = Some(calibrate::thinnest_sheet_wall(s, t0) * resolution as f64);
         }

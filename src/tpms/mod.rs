@@ -22,7 +22,7 @@ use crate::extract::KeyedMesh;
 use crate::field::{Aabb, Intersection, Vec3};
 use crate::grid::{Grid, GridSpec, IndexBox};
 use crate::mesh::Mesh;
-use crate::snap::{snap, SnapStats};
+use crate::snap::SnapStats;
 
 /// Default narrow-band half width, voxels.
 pub const HALF_WIDTH: f64 = 3.0;
@@ -113,6 +113,24 @@ impl Lattice {
         region: Option<IndexBox>,
         adaptivity: f64,
     ) -> Result<(KeyedMesh, MeshingStats)> {
+        self.mesh_keyed_snapped(spec, region, adaptivity, None)
+    }
+
+    /// Volume of the solid inside `b`, a box within the bounds: only the vertices of triangles
+    /// that can reach into `b` (within two voxels of it) are snapped.
+    pub(crate) fn volume_in(&self, spec: GridSpec, adaptivity: f64, b: &Aabb) -> Result<f64> {
+        let within = b.grown(2.0 * spec.voxel);
+        let (keyed, _) = self.mesh_keyed_snapped(spec, None, adaptivity, Some(&within))?;
+        Ok(keyed.to_mesh().volume_in_box(b))
+    }
+
+    fn mesh_keyed_snapped(
+        &self,
+        spec: GridSpec,
+        region: Option<IndexBox>,
+        adaptivity: f64,
+        snap_within: Option<&Aabb>,
+    ) -> Result<(KeyedMesh, MeshingStats)> {
         use std::time::Instant;
         let tpms = self
             .field(spec.half_width * spec.voxel)
@@ -146,7 +164,8 @@ impl Lattice {
         };
         drop(grid);
         let t = Instant::now();
-        let snap_stats = snap(&mut keyed, &tpms, &self.bounds, &spec);
+        let snap_stats =
+            crate::snap::snap_within(&mut keyed, &tpms, &self.bounds, &spec, snap_within);
         Ok((
             keyed,
             MeshingStats {

@@ -156,6 +156,24 @@ impl Surface {
         (v, [g[0] * TAU, g[1] * TAU, g[2] * TAU])
     }
 
+    /// `F` and its gradient (cell coordinates) at the midpoints `(i + ½)/n` of an `n³` grid over
+    /// the unit cell, in the order `(i·n + j)·n + k`; sines and cosines are taken once per axis.
+    pub fn eval_cell_midpoints(self, n: usize) -> Vec<(f64, Vec3)> {
+        use rayon::prelude::*;
+        let tab: Vec<AxisTable> = (0..n)
+            .map(|i| AxisTable::at(TAU * (i as f64 + 0.5) / n as f64))
+            .collect();
+        let terms = self.terms();
+        (0..n * n * n)
+            .into_par_iter()
+            .map(|i| {
+                let ts = [tab[i / (n * n)], tab[(i / n) % n], tab[i % n]];
+                let (v, g) = eval_terms(terms, &ts);
+                (v, g.map(|x| x * TAU))
+            })
+            .collect()
+    }
+
     /// Bounds on `|∂F/∂u_a|` per axis (cell coordinates).
     pub fn lipschitz_per_axis(self) -> Vec3 {
         let mut l = [0.0; 3];
@@ -243,10 +261,11 @@ pub struct TpmsField {
     pub origin: Vec3,
     /// Values are clamped to ±`clamp` (the narrow band's background value).
     pub clamp: f64,
-    /// Samples per cell along each axis, when a cell holds a whole number of samples: block
-    /// sampling then takes each sample's phase from its index modulo this count, so samples one
-    /// cell apart are bit-identical and a periodic lattice meshes identically in every cell.
-    /// (The count per axis and the voxel size it was made for.)
+    /// Samples per cell along each axis where a cell holds a whole number of samples (0 on an
+    /// axis where it does not): block sampling then takes each sample's phase along that axis
+    /// from its index modulo this count, so samples one cell apart are bit-identical and a
+    /// periodic lattice meshes identically in every cell along it. (The counts and the voxel
+    /// size they were made for; `None` when no axis qualifies.)
     pub samples_per_cell: Option<([u32; 3], f64)>,
     lipschitz: f64,
 }
@@ -275,11 +294,19 @@ impl TpmsField {
         }
     }
 
-    /// Turns on index-periodic block sampling when a cell spans a whole number of voxels `h`.
+    /// Turns on index-periodic block sampling along each axis where a cell spans a whole number
+    /// of voxels `h`.
     pub fn with_periodic_samples(mut self, h: f64) -> Self {
-        let p = self.cell.map(|c| (c / h).round());
-        let whole = (0..3).all(|a| p[a] >= 1.0 && (self.cell[a] / h - p[a]).abs() < 1e-9 * p[a]);
-        self.samples_per_cell = whole.then(|| (p.map(|x| x as u32), h));
+        let p = [0, 1, 2].map(|a| {
+            let n = (self.cell[a] / h).round();
+            let whole = n >= 1.0 && (self.cell[a] / h - n).abs() < 1e-9 * n;
+            if whole {
+                n as u32
+            } else {
+                0
+            }
+        });
+        self.samples_per_cell = (p != [0; 3]).then_some((p, h));
         self
     }
 
@@ -353,7 +380,7 @@ impl Field for TpmsField {
             let periodic = self.samples_per_cell.and_then(|(p, hp)| {
                 let j = (origin[a] - self.origin[a]) / h - 0.5;
                 let r = j.round();
-                (hp == h && (j - r).abs() < 1e-6).then_some((r as i64, p[a] as i64))
+                (hp == h && p[a] > 0 && (j - r).abs() < 1e-6).then_some((r as i64, p[a] as i64))
             });
             for (i, t) in tab.iter_mut().enumerate() {
                 let u = match periodic {
@@ -487,8 +514,27 @@ mod tests {
                 assert!((p - w).abs() < 1e-5, "{p} vs {w}");
             }
         }
-        // A cell that is not a whole number of voxels gets no periodic sampling.
+        // A cell that is not a whole number of voxels gets no periodic sampling; one that is
+        // along some axes only gets it along those.
         assert_eq!(f.with_periodic_samples(5.0 / 31.5).samples_per_cell, None);
+        let g = TpmsField::new(
+            Surface::Gyroid,
+            Structure::Net,
+            0.2,
+            [5.0, 5.0, 4.0],
+            phase,
+            1.0,
+        );
+        let mixed = g.with_periodic_samples(0.16);
+        assert_eq!(mixed.samples_per_cell, Some(([0, 0, 25], 0.16)));
+        let at_mixed = |block: [f64; 3]| {
+            let mut out = [0.0f32; 512];
+            let o = [0, 1, 2].map(|a| phase[a] + (block[a] * 8.0 + 0.5) * 0.16);
+            mixed.sample_block(o, 0.16, &mut out);
+            out
+        };
+        // 25 samples per cell along z: 200 samples, 25 blocks, are 8 cells.
+        assert_eq!(at_mixed([1.0, 2.0, 0.0]), at_mixed([1.0, 2.0, 25.0]));
     }
 
     #[test]
