@@ -538,123 +538,125 @@ pub fn check(
 
     let (flip, non_orientable) = orientation(mesh, &topo, &shell_of, nshells);
 
-    // Per shell measures. Vertices counted with a last-seen marker (a vertex shared by shells
-    // touching there counts in each).
-    let mut shell_vertices = vec![0u64; nshells];
-    {
-        let mut seen_in = vec![u32::MAX; nv];
-        for (s, fs) in members.iter().enumerate() {
-            for &f in fs {
-                for k in 0..3 {
-                    let v = mesh.indices[3 * f as usize + k] as usize;
-                    if seen_in[v] != s as u32 {
-                        seen_in[v] = s as u32;
-                        shell_vertices[s] += 1;
+    // CGAL's self-intersection search (the costliest check, building a CGAL mesh one facet at a
+    // time before its parallel search) runs alongside the rest of the check.
+    let (si, (mut shell_reports, inward_shells, normal_report, tj)) = rayon::join(
+        || {
+            opts.self_intersections
+                .then(|| self_intersections(mesh, &topo, &zero, &dups, &flip))
+                .transpose()
+        },
+        || {
+            // Per shell measures. Vertices counted with a last-seen marker (a vertex shared by shells
+            // touching there counts in each).
+            let mut shell_vertices = vec![0u64; nshells];
+            {
+                let mut seen_in = vec![u32::MAX; nv];
+                for (s, fs) in members.iter().enumerate() {
+                    for &f in fs {
+                        for k in 0..3 {
+                            let v = mesh.indices[3 * f as usize + k] as usize;
+                            if seen_in[v] != s as u32 {
+                                seen_in[v] = s as u32;
+                                shell_vertices[s] += 1;
+                            }
+                        }
                     }
                 }
             }
-        }
-    }
-    let mut shell_reports: Vec<ShellReport> = members
-        .par_iter()
-        .enumerate()
-        .map(|(s, fs)| {
-            let (mut volume, mut area) = (0.0, 0.0);
-            for &f in fs {
-                let [a, b, c] = mesh.triangle(f as usize);
-                volume += dot(a, cross(b, c)) / 6.0;
-                area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
+            let mut shell_reports: Vec<ShellReport> = members
+                .par_iter()
+                .enumerate()
+                .map(|(s, fs)| {
+                    let (mut volume, mut area) = (0.0, 0.0);
+                    for &f in fs {
+                        let [a, b, c] = mesh.triangle(f as usize);
+                        volume += dot(a, cross(b, c)) / 6.0;
+                        area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
+                    }
+                    let [edges, boundary_edges, nm] = sh[s];
+                    let euler = shell_vertices[s] as i64 - edges as i64 + fs.len() as i64;
+                    let closed = boundary_edges == 0 && nm == 0;
+                    let orientable = !non_orientable[s];
+                    ShellReport {
+                        facets: fs.len() as u64,
+                        vertices: shell_vertices[s],
+                        edges,
+                        boundary_edges,
+                        non_manifold_edges: nm,
+                        hole_loops: shell_loops[s],
+                        closed,
+                        orientation: Orientation::Inconsistent,
+                        orientable,
+                        volume,
+                        area,
+                        euler,
+                        genus: (closed && orientable && euler % 2 == 0).then_some((2 - euler) / 2),
+                        edge_law: 2 * edges == 3 * fs.len() as u64,
+                        nesting: None,
+                    }
+                })
+                .collect();
+            // Consistency of winding per shell.
+            let mut shell_inconsistent = vec![false; nshells];
+            for e in 0..topo.edge_count() {
+                let hs = topo.edge(e);
+                if hs.len() == 2 && half_edge(mesh, hs[0]) == half_edge(mesh, hs[1]) {
+                    shell_inconsistent[shell_of[(hs[0] / 3) as usize] as usize] = true;
+                }
             }
-            let [edges, boundary_edges, nm] = sh[s];
-            let euler = shell_vertices[s] as i64 - edges as i64 + fs.len() as i64;
-            let closed = boundary_edges == 0 && nm == 0;
-            let orientable = !non_orientable[s];
-            ShellReport {
-                facets: fs.len() as u64,
-                vertices: shell_vertices[s],
-                edges,
-                boundary_edges,
-                non_manifold_edges: nm,
-                hole_loops: shell_loops[s],
-                closed,
-                orientation: Orientation::Inconsistent,
-                orientable,
-                volume,
-                area,
-                euler,
-                genus: (closed && orientable && euler % 2 == 0).then_some((2 - euler) / 2),
-                edge_law: 2 * edges == 3 * fs.len() as u64,
-                nesting: None,
+            let solid: Vec<bool> = shell_reports
+                .iter()
+                .enumerate()
+                .map(|(s, r)| r.closed && !shell_inconsistent[s])
+                .collect();
+            let depth = nesting(mesh, &members, &solid);
+            let mut inward_shells = 0;
+            for (s, r) in shell_reports.iter_mut().enumerate() {
+                r.nesting = depth[s];
+                r.orientation = if shell_inconsistent[s] || !r.orientable {
+                    Orientation::Inconsistent
+                } else if !r.closed {
+                    Orientation::Open
+                } else if (r.volume > 0.0) == depth[s].unwrap_or(0).is_multiple_of(2) {
+                    Orientation::Outward
+                } else {
+                    inward_shells += 1;
+                    Orientation::Inward
+                };
             }
-        })
-        .collect();
-    // Consistency of winding per shell.
-    let mut shell_inconsistent = vec![false; nshells];
-    for e in 0..topo.edge_count() {
-        let hs = topo.edge(e);
-        if hs.len() == 2 && half_edge(mesh, hs[0]) == half_edge(mesh, hs[1]) {
-            shell_inconsistent[shell_of[(hs[0] / 3) as usize] as usize] = true;
-        }
-    }
-    let solid: Vec<bool> = shell_reports
-        .iter()
-        .enumerate()
-        .map(|(s, r)| r.closed && !shell_inconsistent[s])
-        .collect();
-    let depth = nesting(mesh, &members, &solid);
-    let mut inward_shells = 0;
-    for (s, r) in shell_reports.iter_mut().enumerate() {
-        r.nesting = depth[s];
-        r.orientation = if shell_inconsistent[s] || !r.orientable {
-            Orientation::Inconsistent
-        } else if !r.closed {
-            Orientation::Open
-        } else if (r.volume > 0.0) == depth[s].unwrap_or(0).is_multiple_of(2) {
-            Orientation::Outward
-        } else {
-            inward_shells += 1;
-            Orientation::Inward
-        };
-    }
 
-    let normal_report = normals.map(|ns| {
-        let mut r = NormalReport::default();
-        for (f, n) in ns.iter().enumerate().take(nf) {
-            if !topo.active[f] || zero[f] {
-                continue;
-            }
-            r.checked += 1;
-            let n = n.map(|x| x as f64);
-            let ln = norm(n);
-            if !(ln > 0.0 && ln.is_finite()) {
-                r.unset += 1;
-                continue;
-            }
-            let (c, _) = facet_normal(mesh, f);
-            let cos = dot(n, c) / (ln * norm(c));
-            if cos < 0.0 {
-                r.reversed += 1;
-            } else if cos < NORMAL_TOLERANCE_DEG.to_radians().cos() {
-                r.inaccurate += 1;
-            }
-        }
-        r
-    });
+            let normal_report = normals.map(|ns| {
+                let mut r = NormalReport::default();
+                for (f, n) in ns.iter().enumerate().take(nf) {
+                    if !topo.active[f] || zero[f] {
+                        continue;
+                    }
+                    r.checked += 1;
+                    let n = n.map(|x| x as f64);
+                    let ln = norm(n);
+                    if !(ln > 0.0 && ln.is_finite()) {
+                        r.unset += 1;
+                        continue;
+                    }
+                    let (c, _) = facet_normal(mesh, f);
+                    let cos = dot(n, c) / (ln * norm(c));
+                    if cos < 0.0 {
+                        r.reversed += 1;
+                    } else if cos < NORMAL_TOLERANCE_DEG.to_radians().cos() {
+                        r.inaccurate += 1;
+                    }
+                }
+                r
+            });
 
-    let tj = t_junctions(mesh, &topo, opts.tolerance);
-
-    let (self_intersections, examples) = if opts.self_intersections {
-        let mut is_dup = vec![false; nf];
-        for &d in &dups {
-            is_dup[d as usize] = true;
-        }
-        let keep: Vec<u32> = (0..nf as u32)
-            .filter(|&f| topo.active[f as usize] && !zero[f as usize] && !is_dup[f as usize])
-            .collect();
-        let si = crate::repair::cgal::soup_self_intersections(mesh, &keep, Some(&flip), 16)?;
-        (Some(si.0), si.1)
-    } else {
-        (None, Vec::new())
+            let tj = t_junctions(mesh, &topo, opts.tolerance);
+            (shell_reports, inward_shells, normal_report, tj)
+        },
+    );
+    let (self_intersections, examples) = match si? {
+        Some((n, examples)) => (Some(n), examples),
+        None => (None, Vec::new()),
     };
 
     let mut report = CheckReport {
@@ -685,6 +687,27 @@ pub fn check(
     };
     report.valid_solid = report.defects().is_empty();
     Ok(report)
+}
+
+/// Intersecting facet pairs (CGAL) among the facets that are neither degenerate (`zero`, or a
+/// repeated vertex) nor duplicates; up to 16 of them as examples. `flip` winds the facets
+/// consistently, so CGAL can build its mesh as given.
+fn self_intersections(
+    mesh: &Mesh,
+    topo: &Topology,
+    zero: &[bool],
+    dups: &[u32],
+    flip: &[bool],
+) -> Result<(u64, Vec<(u32, u32)>)> {
+    let nf = mesh.triangle_count();
+    let mut is_dup = vec![false; nf];
+    for &d in dups {
+        is_dup[d as usize] = true;
+    }
+    let keep: Vec<u32> = (0..nf as u32)
+        .filter(|&f| topo.active[f as usize] && !zero[f as usize] && !is_dup[f as usize])
+        .collect();
+    crate::repair::cgal::soup_self_intersections(mesh, &keep, Some(flip), 16)
 }
 
 /// The shell of the facet that owns boundary half-edge a→b.
