@@ -452,6 +452,17 @@ pub fn shell_members(shell_of: &[u32], shells: usize) -> Vec<Vec<u32>> {
     m
 }
 
+/// Whole-mesh counts made alongside the self-intersection search.
+struct EdgeCounts {
+    boundary: u64,
+    non_manifold: u64,
+    inconsistent: u64,
+    hole_loops: u64,
+    open_chains: u64,
+    non_manifold_vertices: u64,
+    vertices: u64,
+}
+
 /// Checks `mesh`; `normals` are the stored facet normals if the file had them.
 pub fn check(
     mesh: &Mesh,
@@ -471,82 +482,83 @@ pub fn check(
     let zero_area_facets = zero.iter().filter(|z| **z).count() as u64;
     let dups = duplicate_facets(mesh, &topo);
 
-    // Edges, per shell too.
-    let mut sh = vec![[0u64; 3]; nshells]; // edges, boundary, non-manifold
-    let (mut boundary, mut non_manifold, mut inconsistent) = (0u64, 0u64, 0u64);
-    for e in 0..topo.edge_count() {
-        let hs = topo.edge(e);
-        let s = shell_of[(hs[0] / 3) as usize] as usize;
-        sh[s][0] += 1;
-        match hs.len() {
-            1 => {
-                boundary += 1;
-                sh[s][1] += 1;
-            }
-            2 => {
-                if half_edge(mesh, hs[0]) == half_edge(mesh, hs[1]) {
-                    inconsistent += 1;
-                }
-            }
-            _ => {
-                non_manifold += 1;
-                sh[s][2] += 1;
-            }
-        }
-    }
-    let loops = topo.boundary_loops(mesh);
-    let mut shell_loops = vec![0u64; nshells];
-    let mut open_chains = 0;
-    for l in &loops {
-        if l.closed {
-            // The loop's first edge belongs to a facet of the loop's shell.
-            let (b, a) = (l.vertices[0], l.vertices[1]);
-            if let Some(s) = boundary_shell(mesh, &topo, &shell_of, a, b) {
-                shell_loops[s] += 1;
-            }
-        } else {
-            open_chains += 1;
-        }
-    }
-
-    // Non-manifold vertices: more than one fan.
-    let fans = topo.fans(mesh);
-    let nv = mesh.vertex_count();
-    let mut first_fan = vec![u32::MAX; nv];
-    let mut nm_vertex = vec![false; nv];
-    let mut used = vec![false; nv];
-    for (f, active) in topo.active.iter().enumerate() {
-        if !active {
-            for k in 0..3 {
-                used[mesh.indices[3 * f + k] as usize] = true;
-            }
-            continue;
-        }
-        for k in 0..3 {
-            let c = 3 * f + k;
-            let v = mesh.indices[c] as usize;
-            used[v] = true;
-            if first_fan[v] == u32::MAX {
-                first_fan[v] = fans[c];
-            } else if first_fan[v] != fans[c] {
-                nm_vertex[v] = true;
-            }
-        }
-    }
-    let non_manifold_vertices = nm_vertex.iter().filter(|x| **x).count() as u64;
-    let vertices = used.iter().filter(|x| **x).count() as u64;
-
     let (flip, non_orientable) = orientation(mesh, &topo, &shell_of, nshells);
 
     // CGAL's self-intersection search (the costliest check, building a CGAL mesh one facet at a
-    // time before its parallel search) runs alongside the rest of the check.
-    let (si, (mut shell_reports, inward_shells, normal_report, tj)) = rayon::join(
+    // time before its parallel search) runs alongside the rest of the check: it needs only the
+    // facets to leave out and the winding.
+    let (si, (mut shell_reports, inward_shells, normal_report, tj, counts)) = rayon::join(
         || {
             opts.self_intersections
                 .then(|| self_intersections(mesh, &topo, &zero, &dups, &flip))
                 .transpose()
         },
         || {
+            // Edges, per shell too.
+            let mut sh = vec![[0u64; 3]; nshells]; // edges, boundary, non-manifold
+            let (mut boundary, mut non_manifold, mut inconsistent) = (0u64, 0u64, 0u64);
+            for e in 0..topo.edge_count() {
+                let hs = topo.edge(e);
+                let s = shell_of[(hs[0] / 3) as usize] as usize;
+                sh[s][0] += 1;
+                match hs.len() {
+                    1 => {
+                        boundary += 1;
+                        sh[s][1] += 1;
+                    }
+                    2 => {
+                        if half_edge(mesh, hs[0]) == half_edge(mesh, hs[1]) {
+                            inconsistent += 1;
+                        }
+                    }
+                    _ => {
+                        non_manifold += 1;
+                        sh[s][2] += 1;
+                    }
+                }
+            }
+            let loops = topo.boundary_loops(mesh);
+            let mut shell_loops = vec![0u64; nshells];
+            let mut open_chains = 0;
+            for l in &loops {
+                if l.closed {
+                    // The loop's first edge belongs to a facet of the loop's shell.
+                    let (b, a) = (l.vertices[0], l.vertices[1]);
+                    if let Some(s) = boundary_shell(mesh, &topo, &shell_of, a, b) {
+                        shell_loops[s] += 1;
+                    }
+                } else {
+                    open_chains += 1;
+                }
+            }
+
+            // Non-manifold vertices: more than one fan.
+            let fans = topo.fans(mesh);
+            let nv = mesh.vertex_count();
+            let mut first_fan = vec![u32::MAX; nv];
+            let mut nm_vertex = vec![false; nv];
+            let mut used = vec![false; nv];
+            for (f, active) in topo.active.iter().enumerate() {
+                if !active {
+                    for k in 0..3 {
+                        used[mesh.indices[3 * f + k] as usize] = true;
+                    }
+                    continue;
+                }
+                for k in 0..3 {
+                    let c = 3 * f + k;
+                    let v = mesh.indices[c] as usize;
+                    used[v] = true;
+                    if first_fan[v] == u32::MAX {
+                        first_fan[v] = fans[c];
+                    } else if first_fan[v] != fans[c] {
+                        nm_vertex[v] = true;
+                    }
+                }
+            }
+            let non_manifold_vertices = nm_vertex.iter().filter(|x| **x).count() as u64;
+            let vertices = used.iter().filter(|x| **x).count() as u64;
+
             // Per shell measures. Vertices counted with a last-seen marker (a vertex shared by shells
             // touching there counts in each).
             let mut shell_vertices = vec![0u64; nshells];
@@ -651,7 +663,16 @@ pub fn check(
             });
 
             let tj = t_junctions(mesh, &topo, opts.tolerance);
-            (shell_reports, inward_shells, normal_report, tj)
+            let counts = EdgeCounts {
+                boundary,
+                non_manifold,
+                inconsistent,
+                hole_loops: loops.iter().filter(|l| l.closed).count() as u64,
+                open_chains,
+                non_manifold_vertices,
+                vertices,
+            };
+            (shell_reports, inward_shells, normal_report, tj, counts)
         },
     );
     let (self_intersections, examples) = match si? {
@@ -661,16 +682,16 @@ pub fn check(
 
     let mut report = CheckReport {
         facets: nf as u64,
-        vertices,
-        unreferenced_vertices: nv as u64 - vertices,
+        vertices: counts.vertices,
+        unreferenced_vertices: mesh.vertex_count() as u64 - counts.vertices,
         edges: topo.edge_count() as u64,
         shell_count: nshells as u64,
-        boundary_edges: boundary,
-        hole_loops: loops.iter().filter(|l| l.closed).count() as u64,
-        open_boundary_chains: open_chains,
-        non_manifold_edges: non_manifold,
-        non_manifold_vertices,
-        inconsistent_edges: inconsistent,
+        boundary_edges: counts.boundary,
+        hole_loops: counts.hole_loops,
+        open_boundary_chains: counts.open_chains,
+        non_manifold_edges: counts.non_manifold,
+        non_manifold_vertices: counts.non_manifold_vertices,
+        inconsistent_edges: counts.inconsistent,
         inward_shells,
         non_orientable_shells: non_orientable.iter().filter(|b| **b).count() as u64,
         repeated_vertex_facets,

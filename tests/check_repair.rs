@@ -621,14 +621,17 @@ fn tiled_self_intersection_search_finds_the_pairs_of_the_whole_search() {
         if let Some(b) = brute {
             assert_eq!(whole.0 as usize, b, "{}", file.display());
         }
-        // The split does cut these meshes (a facet in two tiles at most at the first cut).
+        // The split does cut the larger meshes (the five facets of the tetrahedron case are too
+        // large for their tiles, so they stay one tile).
         let soup: Vec<u32> = keep
             .iter()
             .flat_map(|&f| mesh.indices[3 * f as usize..3 * f as usize + 3].to_vec())
             .collect();
         let (faces, starts) = latvox::repair::cgal::box_tiles(&mesh.positions, &soup, 1);
-        assert_eq!(starts.len(), 3, "{}", file.display());
-        assert!(faces.len() < 2 * keep.len());
+        if keep.len() > 100 {
+            assert_eq!(starts.len(), 3, "{}", file.display());
+            assert!(faces.len() < keep.len() * 3 / 2);
+        }
         for depth in [1, 2, 4, 6] {
             let tiled =
                 soup_self_intersections_in_tiles(&mesh, &keep, None, usize::MAX, depth).unwrap();
