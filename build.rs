@@ -50,11 +50,16 @@ fn main() {
         .file("cpp/cgal.cc")
         .compile("latvox_cgal");
 
+    // CGAL's own precondition checks are compiled out here: in the self-intersection search they
+    // cost over a quarter of its CPU time (a whole-mesh triangle test on every call, degeneracy
+    // tests on every triangle and segment compared), and this code meets them by construction
+    // (triangles with three distinct vertices, hole edges checked to be border edges).
     let mut cgal_repair = cxx_build::bridge("src/ffi/cgal_repair.rs");
     flags(&mut cgal_repair);
     cgal_repair
         .define("CGAL_LINKED_WITH_TBB", None)
         .define("CGAL_EIGEN3_ENABLED", None)
+        .define("CGAL_NDEBUG", None)
         .file("cpp/cgal_repair.cc")
         .compile("latvox_cgal_repair");
 

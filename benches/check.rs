@@ -5,7 +5,9 @@
 //!    file: `admesh -c` (read only, no checks) and `admesh` (its default checks and repairs).
 //! 2. `check` (every count, CGAL's self-intersection test included) and `repair` on the clean
 //!    part, and on a damaged copy (1 % of facets reversed, 20 holes cut out).
-//! 3. The whole `latvox repair` command on the damaged copy (read, check, repair, write, read the
+//! 3. CGAL's self-intersection search alone, one search of the whole part against the tiled
+//!    parallel search `check` uses (same pairs).
+//! 4. The whole `latvox repair` command on the damaged copy (read, check, repair, write, read the
 //!    written file back and check it again), as a user runs it.
 //!
 //! Medians of several runs, wall time and (in-process) CPU time of all threads. Run: `cargo bench --bench check` (add `-- --runs N`).
@@ -208,7 +210,27 @@ fn main() {
         );
     }
 
-    println!("\n3. the latvox repair command on the damaged part");
+    println!(
+        "\n3. CGAL's self-intersection search alone on the clean part: the whole mesh at once"
+    );
+    println!("   (one sequential search) and in spatial tiles searched in parallel");
+    let mesh = &loaded.mesh;
+    let all: Vec<u32> = (0..mesh.triangle_count() as u32).collect();
+    let (t_whole, whole) = time(runs, || {
+        latvox::repair::cgal::soup_self_intersections_in_tiles(mesh, &all, None, 16, 0).unwrap()
+    });
+    let c_whole = cpu();
+    let (t_tiled, tiled) = time(runs, || {
+        latvox::repair::cgal::soup_self_intersections(mesh, &all, None, 16).unwrap()
+    });
+    let c_tiled = cpu();
+    assert_eq!(whole, tiled);
+    println!(
+        "  whole {t_whole:.3} s (CPU {c_whole:.3} s)   tiled {t_tiled:.3} s (CPU {c_tiled:.3} s)   pairs {}",
+        whole.0
+    );
+
+    println!("\n4. the latvox repair command on the damaged part");
     let exe = env!("CARGO_BIN_EXE_latvox");
     let out = dir.path().join("fixed.stl");
     let (t_cli, _) = time(runs, || {

@@ -2,7 +2,10 @@
 //  - self-intersections of any triangle soup (non-manifold or inconsistently wound input is first
 //    made a valid Surface_mesh by orient_polygon_soup, which only duplicates vertices and flips
 //    faces, so face i stays polygon i; pairs that share an input vertex are touching, not
-//    crossing, and are left out);
+//    crossing, and are left out). The search runs on spatial tiles of the one mesh given by the
+//    caller (facets whose boxes meet share a tile), each tile by CGAL's sequential box
+//    intersection and exact predicates, the tiles in parallel (TBB); pairs found in several tiles
+//    are counted once. Same mesh, same predicates: the same pairs as one whole-mesh search;
 //  - hole filling: triangulate_refine_and_fair_hole on the border cycles named by the caller,
 //    returning only what was added, so the caller keeps its own vertex and facet numbering.
 #include "cgal_repair.h"
@@ -13,6 +16,8 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/Surface_mesh.h>
+
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -61,9 +66,17 @@ bool add_as_given(rust::Slice<const float> positions, rust::Slice<const uint32_t
 
 SoupIntersections cgal_soup_self_intersections(rust::Slice<const float> positions,
                                                rust::Slice<const uint32_t> indices,
+                                               rust::Slice<const uint32_t> tile_faces,
+                                               rust::Slice<const uint32_t> tile_starts,
                                                std::size_t limit) {
   check_soup(positions, indices);
   const std::size_t nf = indices.size() / 3;
+  if (tile_starts.empty() || tile_starts[tile_starts.size() - 1] != tile_faces.size())
+    throw std::invalid_argument("tile starts must end at the number of tiled facets");
+  for (std::size_t t = 0; t + 1 < tile_starts.size(); ++t)
+    if (tile_starts[t] > tile_starts[t + 1]) throw std::invalid_argument("tile starts decrease");
+  for (auto f : tile_faces)
+    if (f >= nf) throw std::out_of_range("tiled facet past the facet list");
   SoupIntersections out{};
   if (nf == 0) return out;
   SMesh mesh;
@@ -82,9 +95,23 @@ SoupIntersections cgal_soup_self_intersections(rust::Slice<const float> position
     if (mesh.number_of_faces() != nf)
       throw std::runtime_error("the soup could not be made a polygon mesh");
   }
-  std::vector<std::pair<SMesh::Face_index, SMesh::Face_index>> pairs;
-  PMP::self_intersections<CGAL::Parallel_if_available_tag>(faces(mesh), mesh,
-                                                           std::back_inserter(pairs));
+  using FacePair = std::pair<SMesh::Face_index, SMesh::Face_index>;
+  const std::size_t tiles = tile_starts.size() - 1;
+  std::vector<std::vector<FacePair>> found(tiles);
+  tbb::parallel_for(std::size_t(0), tiles, [&](std::size_t t) {
+    std::vector<SMesh::Face_index> range;
+    range.reserve(tile_starts[t + 1] - tile_starts[t]);
+    for (std::size_t i = tile_starts[t]; i < tile_starts[t + 1]; ++i)
+      range.push_back(SMesh::Face_index(tile_faces[i]));
+    PMP::self_intersections<CGAL::Sequential_tag>(range, mesh, std::back_inserter(found[t]));
+  });
+  std::vector<FacePair> pairs;
+  for (auto& f : found) {
+    for (auto p : f) pairs.push_back(p.first < p.second ? p : FacePair(p.second, p.first));
+    std::vector<FacePair>().swap(f);
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   auto shares_vertex = [&](std::size_t f, std::size_t g) {
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j)

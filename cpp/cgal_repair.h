@@ -11,6 +11,8 @@ struct HoleFill;
 
 SoupIntersections cgal_soup_self_intersections(rust::Slice<const float> positions,
                                                rust::Slice<const uint32_t> indices,
+                                               rust::Slice<const uint32_t> tile_faces,
+                                               rust::Slice<const uint32_t> tile_starts,
                                                std::size_t limit);
 
 HoleFill cgal_fill_holes(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,

@@ -452,6 +452,17 @@ pub fn shell_members(shell_of: &[u32], shells: usize) -> Vec<Vec<u32>> {
     m
 }
 
+/// Whole-mesh counts made alongside the self-intersection search.
+struct EdgeCounts {
+    boundary: u64,
+    non_manifold: u64,
+    inconsistent: u64,
+    hole_loops: u64,
+    open_chains: u64,
+    non_manifold_vertices: u64,
+    vertices: u64,
+}
+
 /// Checks `mesh`; `normals` are the stored facet normals if the file had them.
 pub fn check(
     mesh: &Mesh,
@@ -471,204 +482,216 @@ pub fn check(
     let zero_area_facets = zero.iter().filter(|z| **z).count() as u64;
     let dups = duplicate_facets(mesh, &topo);
 
-    // Edges, per shell too.
-    let mut sh = vec![[0u64; 3]; nshells]; // edges, boundary, non-manifold
-    let (mut boundary, mut non_manifold, mut inconsistent) = (0u64, 0u64, 0u64);
-    for e in 0..topo.edge_count() {
-        let hs = topo.edge(e);
-        let s = shell_of[(hs[0] / 3) as usize] as usize;
-        sh[s][0] += 1;
-        match hs.len() {
-            1 => {
-                boundary += 1;
-                sh[s][1] += 1;
-            }
-            2 => {
-                if half_edge(mesh, hs[0]) == half_edge(mesh, hs[1]) {
-                    inconsistent += 1;
-                }
-            }
-            _ => {
-                non_manifold += 1;
-                sh[s][2] += 1;
-            }
-        }
-    }
-    let loops = topo.boundary_loops(mesh);
-    let mut shell_loops = vec![0u64; nshells];
-    let mut open_chains = 0;
-    for l in &loops {
-        if l.closed {
-            // The loop's first edge belongs to a facet of the loop's shell.
-            let (b, a) = (l.vertices[0], l.vertices[1]);
-            if let Some(s) = boundary_shell(mesh, &topo, &shell_of, a, b) {
-                shell_loops[s] += 1;
-            }
-        } else {
-            open_chains += 1;
-        }
-    }
-
-    // Non-manifold vertices: more than one fan.
-    let fans = topo.fans(mesh);
-    let nv = mesh.vertex_count();
-    let mut first_fan = vec![u32::MAX; nv];
-    let mut nm_vertex = vec![false; nv];
-    let mut used = vec![false; nv];
-    for (f, active) in topo.active.iter().enumerate() {
-        if !active {
-            for k in 0..3 {
-                used[mesh.indices[3 * f + k] as usize] = true;
-            }
-            continue;
-        }
-        for k in 0..3 {
-            let c = 3 * f + k;
-            let v = mesh.indices[c] as usize;
-            used[v] = true;
-            if first_fan[v] == u32::MAX {
-                first_fan[v] = fans[c];
-            } else if first_fan[v] != fans[c] {
-                nm_vertex[v] = true;
-            }
-        }
-    }
-    let non_manifold_vertices = nm_vertex.iter().filter(|x| **x).count() as u64;
-    let vertices = used.iter().filter(|x| **x).count() as u64;
-
     let (flip, non_orientable) = orientation(mesh, &topo, &shell_of, nshells);
 
-    // Per shell measures. Vertices counted with a last-seen marker (a vertex shared by shells
-    // touching there counts in each).
-    let mut shell_vertices = vec![0u64; nshells];
-    {
-        let mut seen_in = vec![u32::MAX; nv];
-        for (s, fs) in members.iter().enumerate() {
-            for &f in fs {
-                for k in 0..3 {
-                    let v = mesh.indices[3 * f as usize + k] as usize;
-                    if seen_in[v] != s as u32 {
-                        seen_in[v] = s as u32;
-                        shell_vertices[s] += 1;
+    // CGAL's self-intersection search (the costliest check, building a CGAL mesh one facet at a
+    // time before its parallel search) runs alongside the rest of the check: it needs only the
+    // facets to leave out and the winding.
+    let (si, (mut shell_reports, inward_shells, normal_report, tj, counts)) = rayon::join(
+        || {
+            opts.self_intersections
+                .then(|| self_intersections(mesh, &topo, &zero, &dups, &flip))
+                .transpose()
+        },
+        || {
+            // Edges, per shell too.
+            let mut sh = vec![[0u64; 3]; nshells]; // edges, boundary, non-manifold
+            let (mut boundary, mut non_manifold, mut inconsistent) = (0u64, 0u64, 0u64);
+            for e in 0..topo.edge_count() {
+                let hs = topo.edge(e);
+                let s = shell_of[(hs[0] / 3) as usize] as usize;
+                sh[s][0] += 1;
+                match hs.len() {
+                    1 => {
+                        boundary += 1;
+                        sh[s][1] += 1;
+                    }
+                    2 => {
+                        if half_edge(mesh, hs[0]) == half_edge(mesh, hs[1]) {
+                            inconsistent += 1;
+                        }
+                    }
+                    _ => {
+                        non_manifold += 1;
+                        sh[s][2] += 1;
                     }
                 }
             }
-        }
-    }
-    let mut shell_reports: Vec<ShellReport> = members
-        .par_iter()
-        .enumerate()
-        .map(|(s, fs)| {
-            let (mut volume, mut area) = (0.0, 0.0);
-            for &f in fs {
-                let [a, b, c] = mesh.triangle(f as usize);
-                volume += dot(a, cross(b, c)) / 6.0;
-                area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
+            let loops = topo.boundary_loops(mesh);
+            let mut shell_loops = vec![0u64; nshells];
+            let mut open_chains = 0;
+            for l in &loops {
+                if l.closed {
+                    // The loop's first edge belongs to a facet of the loop's shell.
+                    let (b, a) = (l.vertices[0], l.vertices[1]);
+                    if let Some(s) = boundary_shell(mesh, &topo, &shell_of, a, b) {
+                        shell_loops[s] += 1;
+                    }
+                } else {
+                    open_chains += 1;
+                }
             }
-            let [edges, boundary_edges, nm] = sh[s];
-            let euler = shell_vertices[s] as i64 - edges as i64 + fs.len() as i64;
-            let closed = boundary_edges == 0 && nm == 0;
-            let orientable = !non_orientable[s];
-            ShellReport {
-                facets: fs.len() as u64,
-                vertices: shell_vertices[s],
-                edges,
-                boundary_edges,
-                non_manifold_edges: nm,
-                hole_loops: shell_loops[s],
-                closed,
-                orientation: Orientation::Inconsistent,
-                orientable,
-                volume,
-                area,
-                euler,
-                genus: (closed && orientable && euler % 2 == 0).then_some((2 - euler) / 2),
-                edge_law: 2 * edges == 3 * fs.len() as u64,
-                nesting: None,
-            }
-        })
-        .collect();
-    // Consistency of winding per shell.
-    let mut shell_inconsistent = vec![false; nshells];
-    for e in 0..topo.edge_count() {
-        let hs = topo.edge(e);
-        if hs.len() == 2 && half_edge(mesh, hs[0]) == half_edge(mesh, hs[1]) {
-            shell_inconsistent[shell_of[(hs[0] / 3) as usize] as usize] = true;
-        }
-    }
-    let solid: Vec<bool> = shell_reports
-        .iter()
-        .enumerate()
-        .map(|(s, r)| r.closed && !shell_inconsistent[s])
-        .collect();
-    let depth = nesting(mesh, &members, &solid);
-    let mut inward_shells = 0;
-    for (s, r) in shell_reports.iter_mut().enumerate() {
-        r.nesting = depth[s];
-        r.orientation = if shell_inconsistent[s] || !r.orientable {
-            Orientation::Inconsistent
-        } else if !r.closed {
-            Orientation::Open
-        } else if (r.volume > 0.0) == depth[s].unwrap_or(0).is_multiple_of(2) {
-            Orientation::Outward
-        } else {
-            inward_shells += 1;
-            Orientation::Inward
-        };
-    }
 
-    let normal_report = normals.map(|ns| {
-        let mut r = NormalReport::default();
-        for (f, n) in ns.iter().enumerate().take(nf) {
-            if !topo.active[f] || zero[f] {
-                continue;
+            // Non-manifold vertices: more than one fan.
+            let fans = topo.fans(mesh);
+            let nv = mesh.vertex_count();
+            let mut first_fan = vec![u32::MAX; nv];
+            let mut nm_vertex = vec![false; nv];
+            let mut used = vec![false; nv];
+            for (f, active) in topo.active.iter().enumerate() {
+                if !active {
+                    for k in 0..3 {
+                        used[mesh.indices[3 * f + k] as usize] = true;
+                    }
+                    continue;
+                }
+                for k in 0..3 {
+                    let c = 3 * f + k;
+                    let v = mesh.indices[c] as usize;
+                    used[v] = true;
+                    if first_fan[v] == u32::MAX {
+                        first_fan[v] = fans[c];
+                    } else if first_fan[v] != fans[c] {
+                        nm_vertex[v] = true;
+                    }
+                }
             }
-            r.checked += 1;
-            let n = n.map(|x| x as f64);
-            let ln = norm(n);
-            if !(ln > 0.0 && ln.is_finite()) {
-                r.unset += 1;
-                continue;
-            }
-            let (c, _) = facet_normal(mesh, f);
-            let cos = dot(n, c) / (ln * norm(c));
-            if cos < 0.0 {
-                r.reversed += 1;
-            } else if cos < NORMAL_TOLERANCE_DEG.to_radians().cos() {
-                r.inaccurate += 1;
-            }
-        }
-        r
-    });
+            let non_manifold_vertices = nm_vertex.iter().filter(|x| **x).count() as u64;
+            let vertices = used.iter().filter(|x| **x).count() as u64;
 
-    let tj = t_junctions(mesh, &topo, opts.tolerance);
+            // Per shell measures. Vertices counted with a last-seen marker (a vertex shared by shells
+            // touching there counts in each).
+            let mut shell_vertices = vec![0u64; nshells];
+            {
+                let mut seen_in = vec![u32::MAX; nv];
+                for (s, fs) in members.iter().enumerate() {
+                    for &f in fs {
+                        for k in 0..3 {
+                            let v = mesh.indices[3 * f as usize + k] as usize;
+                            if seen_in[v] != s as u32 {
+                                seen_in[v] = s as u32;
+                                shell_vertices[s] += 1;
+                            }
+                        }
+                    }
+                }
+            }
+            let mut shell_reports: Vec<ShellReport> = members
+                .par_iter()
+                .enumerate()
+                .map(|(s, fs)| {
+                    let (mut volume, mut area) = (0.0, 0.0);
+                    for &f in fs {
+                        let [a, b, c] = mesh.triangle(f as usize);
+                        volume += dot(a, cross(b, c)) / 6.0;
+                        area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
+                    }
+                    let [edges, boundary_edges, nm] = sh[s];
+                    let euler = shell_vertices[s] as i64 - edges as i64 + fs.len() as i64;
+                    let closed = boundary_edges == 0 && nm == 0;
+                    let orientable = !non_orientable[s];
+                    ShellReport {
+                        facets: fs.len() as u64,
+                        vertices: shell_vertices[s],
+                        edges,
+                        boundary_edges,
+                        non_manifold_edges: nm,
+                        hole_loops: shell_loops[s],
+                        closed,
+                        orientation: Orientation::Inconsistent,
+                        orientable,
+                        volume,
+                        area,
+                        euler,
+                        genus: (closed && orientable && euler % 2 == 0).then_some((2 - euler) / 2),
+                        edge_law: 2 * edges == 3 * fs.len() as u64,
+                        nesting: None,
+                    }
+                })
+                .collect();
+            // Consistency of winding per shell.
+            let mut shell_inconsistent = vec![false; nshells];
+            for e in 0..topo.edge_count() {
+                let hs = topo.edge(e);
+                if hs.len() == 2 && half_edge(mesh, hs[0]) == half_edge(mesh, hs[1]) {
+                    shell_inconsistent[shell_of[(hs[0] / 3) as usize] as usize] = true;
+                }
+            }
+            let solid: Vec<bool> = shell_reports
+                .iter()
+                .enumerate()
+                .map(|(s, r)| r.closed && !shell_inconsistent[s])
+                .collect();
+            let depth = nesting(mesh, &members, &solid);
+            let mut inward_shells = 0;
+            for (s, r) in shell_reports.iter_mut().enumerate() {
+                r.nesting = depth[s];
+                r.orientation = if shell_inconsistent[s] || !r.orientable {
+                    Orientation::Inconsistent
+                } else if !r.closed {
+                    Orientation::Open
+                } else if (r.volume > 0.0) == depth[s].unwrap_or(0).is_multiple_of(2) {
+                    Orientation::Outward
+                } else {
+                    inward_shells += 1;
+                    Orientation::Inward
+                };
+            }
 
-    let (self_intersections, examples) = if opts.self_intersections {
-        let mut is_dup = vec![false; nf];
-        for &d in &dups {
-            is_dup[d as usize] = true;
-        }
-        let keep: Vec<u32> = (0..nf as u32)
-            .filter(|&f| topo.active[f as usize] && !zero[f as usize] && !is_dup[f as usize])
-            .collect();
-        let si = crate::repair::cgal::soup_self_intersections(mesh, &keep, Some(&flip), 16)?;
-        (Some(si.0), si.1)
-    } else {
-        (None, Vec::new())
+            let normal_report = normals.map(|ns| {
+                let mut r = NormalReport::default();
+                for (f, n) in ns.iter().enumerate().take(nf) {
+                    if !topo.active[f] || zero[f] {
+                        continue;
+                    }
+                    r.checked += 1;
+                    let n = n.map(|x| x as f64);
+                    let ln = norm(n);
+                    if !(ln > 0.0 && ln.is_finite()) {
+                        r.unset += 1;
+                        continue;
+                    }
+                    let (c, _) = facet_normal(mesh, f);
+                    let cos = dot(n, c) / (ln * norm(c));
+                    if cos < 0.0 {
+                        r.reversed += 1;
+                    } else if cos < NORMAL_TOLERANCE_DEG.to_radians().cos() {
+                        r.inaccurate += 1;
+                    }
+                }
+                r
+            });
+
+            let tj = t_junctions(mesh, &topo, opts.tolerance);
+            let counts = EdgeCounts {
+                boundary,
+                non_manifold,
+                inconsistent,
+                hole_loops: loops.iter().filter(|l| l.closed).count() as u64,
+                open_chains,
+                non_manifold_vertices,
+                vertices,
+            };
+            (shell_reports, inward_shells, normal_report, tj, counts)
+        },
+    );
+    let (self_intersections, examples) = match si? {
+        Some((n, examples)) => (Some(n), examples),
+        None => (None, Vec::new()),
     };
 
     let mut report = CheckReport {
         facets: nf as u64,
-        vertices,
-        unreferenced_vertices: nv as u64 - vertices,
+        vertices: counts.vertices,
+        unreferenced_vertices: mesh.vertex_count() as u64 - counts.vertices,
         edges: topo.edge_count() as u64,
         shell_count: nshells as u64,
-        boundary_edges: boundary,
-        hole_loops: loops.iter().filter(|l| l.closed).count() as u64,
-        open_boundary_chains: open_chains,
-        non_manifold_edges: non_manifold,
-        non_manifold_vertices,
-        inconsistent_edges: inconsistent,
+        boundary_edges: counts.boundary,
+        hole_loops: counts.hole_loops,
+        open_boundary_chains: counts.open_chains,
+        non_manifold_edges: counts.non_manifold,
+        non_manifold_vertices: counts.non_manifold_vertices,
+        inconsistent_edges: counts.inconsistent,
         inward_shells,
         non_orientable_shells: non_orientable.iter().filter(|b| **b).count() as u64,
         repeated_vertex_facets,
@@ -685,6 +708,27 @@ pub fn check(
     };
     report.valid_solid = report.defects().is_empty();
     Ok(report)
+}
+
+/// Intersecting facet pairs (CGAL) among the facets that are neither degenerate (`zero`, or a
+/// repeated vertex) nor duplicates; up to 16 of them as examples. `flip` winds the facets
+/// consistently, so CGAL can build its mesh as given.
+fn self_intersections(
+    mesh: &Mesh,
+    topo: &Topology,
+    zero: &[bool],
+    dups: &[u32],
+    flip: &[bool],
+) -> Result<(u64, Vec<(u32, u32)>)> {
+    let nf = mesh.triangle_count();
+    let mut is_dup = vec![false; nf];
+    for &d in dups {
+        is_dup[d as usize] = true;
+    }
+    let keep: Vec<u32> = (0..nf as u32)
+        .filter(|&f| topo.active[f as usize] && !zero[f as usize] && !is_dup[f as usize])
+        .collect();
+    crate::repair::cgal::soup_self_intersections(mesh, &keep, Some(flip), 16)
 }
 
 /// The shell of the facet that owns boundary half-edge a→b.

@@ -565,6 +565,81 @@ fn synthetic_defects_are_counted_and_mended() {
     assert!((vol / union - 1.0).abs() < 0.01, "{vol} vs {union}");
 }
 
+/// A torus (R = 4, r = 1.5) of `nu × nv` quads, moved by `offset`, as triangles.
+fn torus(nu: usize, nv: usize, offset: P) -> Vec<Tri> {
+    let point = |i: usize, j: usize| {
+        let u = 2.0 * std::f64::consts::PI * (i % nu) as f64 / nu as f64;
+        let v = 2.0 * std::f64::consts::PI * (j % nv) as f64 / nv as f64;
+        let r = 4.0 + 1.5 * v.cos();
+        let p = [r * u.cos(), r * u.sin(), 1.5 * v.sin()];
+        // Rounded to f32 as the file holds them, so the brute force sees the same points.
+        [0, 1, 2].map(|k| (p[k] + offset[k]) as f32 as f64)
+    };
+    let mut tris = Vec::new();
+    for i in 0..nu {
+        for j in 0..nv {
+            let (a, b, c, d) = (
+                point(i, j),
+                point(i + 1, j),
+                point(i + 1, j + 1),
+                point(i, j + 1),
+            );
+            tris.push([a, b, c]);
+            tris.push([a, c, d]);
+        }
+    }
+    tris
+}
+
+/// The self-intersection search runs on spatial tiles searched in parallel: it must find exactly
+/// the pairs one search of the whole mesh finds, at every depth of the split. Checked on CGAL's
+/// self-intersecting meshes (the devil mannequin; the pig with holes and pinched vertices; a
+/// tetrahedron crossed by a triangle) and on two interpenetrating tori, whose count is also
+/// brute-forced.
+#[test]
+fn tiled_self_intersection_search_finds_the_pairs_of_the_whole_search() {
+    use latvox::repair::cgal::soup_self_intersections_in_tiles;
+    let data = cgal_data();
+    let dir = tempdir();
+    let mut tori = torus(40, 20, [0.0; 3]);
+    tori.extend(torus(40, 20, [1.3, 0.7, 0.45]));
+    let tori_file = dir.path().join("tori.stl");
+    write_stl(&tori_file, &tori);
+    for (file, brute) in [
+        (data.join("mannequin-devil.off"), None),
+        (data.join("pig.stl"), None),
+        (data.join("tetra_intersected_by_triangle.off"), None),
+        (tori_file, Some(intersecting_pairs(&tori))),
+    ] {
+        let mesh = latvox::io::read(&file, &Default::default()).unwrap().mesh;
+        let keep: Vec<u32> = (0..mesh.triangle_count() as u32)
+            .filter(|&f| !latvox::topology::repeats_vertex(&mesh, f as usize))
+            .collect();
+        let whole = soup_self_intersections_in_tiles(&mesh, &keep, None, usize::MAX, 0).unwrap();
+        assert!(whole.0 > 0, "{}", file.display());
+        assert_eq!(whole.0 as usize, whole.1.len());
+        if let Some(b) = brute {
+            assert_eq!(whole.0 as usize, b, "{}", file.display());
+        }
+        // The split does cut the larger meshes (the five facets of the tetrahedron case are too
+        // large for their tiles, so they stay one tile).
+        let soup: Vec<u32> = keep
+            .iter()
+            .flat_map(|&f| mesh.indices[3 * f as usize..3 * f as usize + 3].to_vec())
+            .collect();
+        let (faces, starts) = latvox::repair::cgal::box_tiles(&mesh.positions, &soup, 1);
+        if keep.len() > 100 {
+            assert_eq!(starts.len(), 3, "{}", file.display());
+            assert!(faces.len() < keep.len() * 3 / 2);
+        }
+        for depth in [1, 2, 4, 6] {
+            let tiled =
+                soup_self_intersections_in_tiles(&mesh, &keep, None, usize::MAX, depth).unwrap();
+            assert_eq!(tiled, whole, "{} at depth {depth}", file.display());
+        }
+    }
+}
+
 /// An open flat sheet cannot be closed: it is reported, kept, and dropped only when asked.
 #[test]
 fn open_shells_are_reported_and_dropped_only_on_request() {

@@ -68,14 +68,15 @@ pub fn run(a: &CheckArgs, quiet: bool) -> Result<i32> {
         self_intersections: !a.common.no_self_intersection,
         tolerance: a.common.weld_tolerance,
     };
-    let report = {
+    // CGAL's own checks (building a mesh of its own, one facet at a time) run alongside ours.
+    let (report, cgal) = {
         let _s = progress.stage("checking");
-        latvox::check::check(mesh, loaded.normals.as_deref(), &opts)?
+        rayon::join(
+            || latvox::check::check(mesh, loaded.normals.as_deref(), &opts),
+            || latvox::verify::verify(mesh, false),
+        )
     };
-    let mut cgal = {
-        let _s = progress.stage("CGAL checks");
-        latvox::verify::verify(mesh, false)?
-    };
+    let (report, mut cgal) = (report?, cgal?);
     // The check above already ran CGAL's self-intersection test (on the facets that are neither
     // degenerate nor duplicate); it is not run twice.
     cgal.self_intersection_checked = report.self_intersections.is_some();

@@ -22,9 +22,13 @@ pub(crate) mod ffi {
     unsafe extern "C++" {
         include!("latvox/cpp/cgal_repair.h");
 
+        /// Searches each tile (`tile_faces[tile_starts[t]..tile_starts[t + 1]]`) on its own;
+        /// pairs found in several tiles count once.
         fn cgal_soup_self_intersections(
             positions: &[f32],
             indices: &[u32],
+            tile_faces: &[u32],
+            tile_starts: &[u32],
             limit: usize,
         ) -> Result<SoupIntersections>;
 

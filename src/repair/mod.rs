@@ -25,6 +25,7 @@ use crate::error::Result;
 use crate::mesh::{cross, dot, sub, Mesh};
 use crate::progress::Progress;
 use crate::topology::Topology;
+use rayon::prelude::*;
 
 pub use holes::PLANAR_REL;
 
@@ -130,6 +131,7 @@ impl Work {
         let active = self.parts().1.active.clone();
         let repeated = active.iter().filter(|a| !**a).count() as u64;
         let zero: Vec<bool> = (0..nf)
+            .into_par_iter()
             .map(|f| active[f] && zero_area(&self.mesh, f))
             .collect();
         let zero_count = zero.iter().filter(|z| **z).count() as u64;
