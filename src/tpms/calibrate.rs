@@ -304,10 +304,7 @@ pub fn calibrate(
         max: cell,
     };
     let cell_volume = cell_box.volume();
-    let m = std::env::var("XMARGIN")
-        .map(|v| v.parse::<f64>().unwrap())
-        .unwrap_or(MARGIN)
-        * voxel;
+    let m = MARGIN * voxel;
     let padded = Aabb {
         min: [-m; 3],
         max: [0, 1, 2].map(|a| cell[a] + m),
@@ -361,9 +358,6 @@ pub fn calibrate(
         let ib = interior(tb)?;
         meshings += 1;
         let pb = predict(ib);
-        if std::env::var("XDBG").is_ok() {
-            eprintln!("{surface:?} {structure:?} t0 {t0:.5} p0 {:.5} ta {ta:.5} pa {pa:.6} tb {tb:.5} pb {pb:.6} A(tb) {:.6}", predict(0.0) , analytic_fraction(surface, structure, tb));
-        }
         let s = if (pb - pa).abs() > 1e-12 {
             (pb - pa) / (tb - ta)
         } else {
