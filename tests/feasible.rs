@@ -1,28 +1,15 @@
 //! The feasible ranges latvox refuses densities by are right at both ends: the tabulated ranges
-//! (`calibrate::PERCOLATION`) are recomputed here at each end by an independent percolation test
-//! of the sampled unit cell (union-find over a periodic 2×2×2 block), and the command line refuses
+//! (`calibrate::PERCOLATION`, constants in the source) are tested here just inside and just
+//! outside each end by percolation of the sampled unit cell (union-find over a periodic 2×2×2
+//! block), and the command line refuses
 //! a density just outside the solid's range with the range in its one-line message.
 
-use latvox::tpms::calibrate::{analytic_level, connectivity_sampled, PERCOLATION};
+use latvox::tpms::calibrate::{percolates, PERCOLATION};
 use latvox::tpms::{Structure, Surface};
 use std::process::Command;
 
 /// How far inside / outside an end the test looks, in volume fraction.
 const STEP: f64 = 0.004;
-
-fn phase_connected(surface: Surface, structure: Structure, vf: f64, void: bool, n: usize) -> bool {
-    let c = connectivity_sampled(
-        surface,
-        structure,
-        analytic_level(surface, structure, vf),
-        n,
-    );
-    if void {
-        c.void
-    } else {
-        c.solid
-    }
-}
 
 #[test]
 fn every_tabulated_range_end_is_where_percolation_changes() {
@@ -41,8 +28,8 @@ fn every_tabulated_range_end_is_where_percolation_changes() {
                 // Ends below 0.12 are thin-strut limits, resolved at 128 samples per cell.
                 let n = if end < 0.12 { 128 } else { 64 };
                 let (a, b) = (
-                    phase_connected(surface, structure, inside, is_void, n),
-                    phase_connected(surface, structure, outside, is_void, n),
+                    percolates(surface, structure, inside, n, is_void),
+                    percolates(surface, structure, outside, n, is_void),
                 );
                 let what = if is_void { "void" } else { "solid" };
                 eprintln!(

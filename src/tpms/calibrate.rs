@@ -202,6 +202,22 @@ pub fn feasible_range(surface: Surface, structure: Structure) -> FeasibleRange {
     percolation_range(surface, structure, NC, false)
 }
 
+/// Whether the solid (or, with `void`, the void) percolates at volume fraction `vf`, sampled
+/// `n` per cell axis.
+pub fn percolates(surface: Surface, structure: Structure, vf: f64, n: usize, void: bool) -> bool {
+    let c = connectivity_sampled(
+        surface,
+        structure,
+        analytic_level(surface, structure, vf),
+        n,
+    );
+    if void {
+        c.void
+    } else {
+        c.solid
+    }
+}
+
 /// The range of volume fraction around the middle where the solid (or, with `void`, the void)
 /// percolates, sampled `n` per cell axis.
 pub fn percolation_range(
@@ -210,19 +226,7 @@ pub fn percolation_range(
     n: usize,
     void: bool,
 ) -> FeasibleRange {
-    let ok = |vf: f64| {
-        let c = connectivity_sampled(
-            surface,
-            structure,
-            analytic_level(surface, structure, vf),
-            n,
-        );
-        if void {
-            c.void
-        } else {
-            c.solid
-        }
-    };
+    let ok = |vf: f64| percolates(surface, structure, vf, n, void);
     let step = 0.01;
     let start = (0..50)
         .flat_map(|k| [0.5 + k as f64 * step, 0.5 - k as f64 * step])
