@@ -5,7 +5,6 @@
 //! a density just outside the solid's range with the range in its one-line message.
 
 use latvox::tpms::calibrate::{percolates, PERCOLATION};
-use latvox::tpms::{Structure, Surface};
 use std::process::Command;
 
 /// How far inside / outside an end the test looks, in volume fraction.
