@@ -22,12 +22,14 @@ Examples:
   # A 50×30×10 mm block filled with 10 mm Schwarz-P cells (partial cells at the far sides)
   latvox tpms --type p --density 0.35 --size 50,30,10 --cell-size 10 -o p-block.stl
 
-  # 30×30×30 cells (27,000) as a 3MF package: periodic cells are copies of a meshed template,
-  # streamed to the file; memory stays flat whatever the cell count
-  latvox tpms --type gyroid --density 0.3 --cells 30 --cell-size 5 --resolution 16 -o big.3mf
+  # 30×30×30 cells (27,000): periodic cells are copies of a meshed template, streamed to the
+  # STL, so memory stays flat whatever the cell count (name it .3mf for a 3MF package, which
+  # holds an index per distinct vertex while it is written)
+  latvox tpms --type gyroid --density 0.3 --cells 30 --cell-size 5 --resolution 16 -o big.stl
 
-  # The whole part meshed in tiles that fit a 1 GB budget, streamed to the file (the path
-  # taken when cells cannot be copied: a box that ends inside a voxel, or --no-instancing)
+  # The whole part meshed in tiles that fit a 1 GB budget, streamed to the file (the path taken
+  # when cells cannot be copied — a cell that is not a whole number of 8-voxel blocks — or with
+  # --no-instancing)
   latvox tpms --type d --density 0.25 --cells 20 --cell-size 6 --no-instancing --memory 1G -o d.stl
 
 Types: p (Schwarz primitive), g|gyroid, d (Schwarz diamond), iwp (Schoen I-WP),
