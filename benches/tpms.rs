@@ -10,6 +10,7 @@
 //!
 //! Run: `cargo bench --bench tpms` (add `-- --runs N` to change the repeat count).
 
+use std::path::Path;
 use std::process::Command;
 use std::time::Instant;
 
@@ -37,6 +38,29 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// Runs `latvox ARGS -o out --report out.json` `runs` times: median wall time (s), median peak
+/// RSS (MB), and the last run's report.
+fn measure(exe: &str, args: &[&str], out: &Path, runs: usize) -> (f64, f64, serde_json::Value) {
+    let report = out.with_extension("json");
+    let mut walls = Vec::new();
+    let mut rss = Vec::new();
+    for _ in 0..runs {
+        let mut c = Command::new(exe);
+        c.args(args)
+            .arg("-o")
+            .arg(out)
+            .arg("--report")
+            .arg(&report)
+            .stdout(std::process::Stdio::null());
+        let (s, m, code) = run_measured(&mut c);
+        assert_eq!(code, 0, "latvox {} failed", args.join(" "));
+        walls.push(s);
+        rss.push(m);
+    }
+    let rep = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    (median(walls), median(rss), rep)
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let runs = args
@@ -52,6 +76,16 @@ fn main() {
         .unwrap_or(1);
     println!("machine: {threads} threads; {runs} runs per case, median reported");
 
+    let gyroid = [
+        "tpms",
+        "-t",
+        "gyroid",
+        "--structure",
+        "net",
+        "-d",
+        "0.3",
+        "--quiet",
+    ];
     for (label, extra) in [
         (
             "full pipeline (CGAL checks incl. self-intersection)",
@@ -62,47 +96,13 @@ fn main() {
             vec!["--no-self-intersection-check"],
         ),
     ] {
-        let mut walls = Vec::new();
-        let mut rss = Vec::new();
+        let mut args = gyroid.to_vec();
+        args.extend(["--cells", "10", "--cell-size", "5", "--resolution", "32"]);
+        args.extend(extra);
         let out = dir.path().join("g10.stl");
-        let report = dir.path().join("g10.json");
-        for _ in 0..runs {
-            let mut c = Command::new(exe);
-            c.args([
-                "tpms",
-                "--type",
-                "gyroid",
-                "--structure",
-                "net",
-                "--density",
-                "0.3",
-            ])
-            .args([
-                "--cells",
-                "10",
-                "--cell-size",
-                "5",
-                "--resolution",
-                "32",
-                "--quiet",
-            ])
-            .arg("-o")
-            .arg(&out)
-            .arg("--report")
-            .arg(&report)
-            .args(&extra)
-            .stdout(std::process::Stdio::null());
-            let (s, m, code) = run_measured(&mut c);
-            assert_eq!(code, 0, "latvox failed");
-            walls.push(s);
-            rss.push(m);
-        }
-        let rep: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        let (wall, rss, rep) = measure(exe, &args, &out, runs);
         println!(
-            "gyroid net 0.30, 10x10x10 cells, 320^3 grid, {label}: wall {:.2} s (median), peak RSS {:.0} MB; {} triangles, STL {:.0} MB, achieved density {:.5}",
-            median(walls),
-            median(rss),
+            "gyroid net 0.30, 10x10x10 cells, 320^3 grid, {label}: wall {wall:.2} s (median), peak RSS {rss:.0} MB; {} triangles, STL {:.0} MB, achieved density {:.5}",
             rep["triangles"],
             std::fs::metadata(&out).unwrap().len() as f64 / 1e6,
             rep["achieved_density"].as_f64().unwrap()
@@ -111,51 +111,30 @@ fn main() {
     }
 
     println!("scale: gyroid net 0.30, 16 voxels per cell, 5 mm cells, STL or 3MF written:");
-    for (label, cells, extra) in [
-        ("10x10x10 cells, instanced, STL", "10", vec![]),
-        ("30x30x30 cells, instanced, STL", "30", vec![]),
-        ("30x30x30 cells, instanced, 3MF", "30", vec!["3mf"]),
+    for (label, cells, file, extra) in [
+        ("10x10x10 cells, instanced, STL", "10", "s.stl", vec![]),
+        ("30x30x30 cells, instanced, STL", "30", "s.stl", vec![]),
+        ("30x30x30 cells, instanced, 3MF", "30", "s.3mf", vec![]),
         (
             "10x10x10 cells, whole part meshed at once",
             "10",
+            "s.stl",
             vec!["--no-instancing"],
         ),
         (
             "10x10x10 cells, tiles for a 64 MB budget",
             "10",
+            "s.stl",
             vec!["--no-instancing", "--memory", "64M"],
         ),
     ] {
-        let mut walls = Vec::new();
-        let mut rss = Vec::new();
-        let ext = if extra.first() == Some(&"3mf") {
-            "3mf"
-        } else {
-            "stl"
-        };
-        let out = dir.path().join(format!("s.{ext}"));
-        let report = dir.path().join("s.json");
-        for _ in 0..runs {
-            let mut c = Command::new(exe);
-            c.args(["tpms", "-t", "gyroid", "-d", "0.3", "--cells", cells])
-                .args(["--cell-size", "5", "--resolution", "16", "--quiet"])
-                .arg("-o")
-                .arg(&out)
-                .arg("--report")
-                .arg(&report)
-                .args(extra.iter().filter(|a| **a != "3mf"))
-                .stdout(std::process::Stdio::null());
-            let (s, m, code) = run_measured(&mut c);
-            assert_eq!(code, 0, "latvox failed on {label}");
-            walls.push(s);
-            rss.push(m);
-        }
-        let rep: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        let mut args = gyroid.to_vec();
+        args.extend(["--cells", cells, "--cell-size", "5", "--resolution", "16"]);
+        args.extend(extra);
+        let out = dir.path().join(file);
+        let (wall, rss, rep) = measure(exe, &args, &out, runs);
         println!(
-            "  {label}: wall {:.2} s, peak RSS {:.0} MB (medians); {} triangles, file {:.0} MB, achieved density {:.5}",
-            median(walls),
-            median(rss),
+            "  {label}: wall {wall:.2} s, peak RSS {rss:.0} MB (medians); {} triangles, file {:.0} MB, achieved density {:.5}",
             rep["triangles"],
             std::fs::metadata(&out).unwrap().len() as f64 / 1e6,
             rep["achieved_density"].as_f64().unwrap()

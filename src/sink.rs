@@ -235,11 +235,26 @@ impl MeshSink for StlSink {
     }
 }
 
+/// Exact welding: one index per distinct corner (`+0.0` and `-0.0` are one), numbered in the
+/// order corners first arrive.
+#[derive(Default)]
+struct ExactWeld(HashMap<[u32; 3], u32>);
+
+impl ExactWeld {
+    /// The corner's index, and whether it is new.
+    fn index(&mut self, p: &[f32; 3]) -> (u32, bool) {
+        let key = p.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
+        let next = self.0.len() as u32;
+        let id = *self.0.entry(key).or_insert(next);
+        (id, id == next)
+    }
+}
+
 /// Gathers streamed triangles into an indexed mesh, welding bit-identical corners.
 #[derive(Default)]
 pub struct MeshCollector {
     pub mesh: Mesh,
-    index: HashMap<[u32; 3], u32>,
+    weld: ExactWeld,
 }
 
 impl MeshSink for MeshCollector {
@@ -253,10 +268,8 @@ impl MeshSink for MeshCollector {
     fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
         for t in batch {
             for p in t {
-                let key = p.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
-                let next = self.index.len() as u32;
-                let id = *self.index.entry(key).or_insert(next);
-                if id == next {
+                let (id, new) = self.weld.index(p);
+                if new {
                     self.mesh.positions.extend_from_slice(p);
                 }
                 self.mesh.indices.push(id);
@@ -278,7 +291,7 @@ pub struct ThreeMfSink {
     path: PathBuf,
     vertices: std::io::BufWriter<std::fs::File>,
     triangles: std::io::BufWriter<std::fs::File>,
-    index: HashMap<[u32; 3], u32>,
+    weld: ExactWeld,
 }
 
 impl ThreeMfSink {
@@ -294,7 +307,7 @@ impl ThreeMfSink {
             path: path.to_path_buf(),
             vertices: scratch()?,
             triangles: scratch()?,
-            index: HashMap::new(),
+            weld: ExactWeld::default(),
         })
     }
 
@@ -353,10 +366,9 @@ impl MeshSink for ThreeMfSink {
         for t in batch {
             let mut ids = [0u32; 3];
             for (id, p) in ids.iter_mut().zip(t) {
-                let key = p.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
-                let next = self.index.len() as u32;
-                *id = *self.index.entry(key).or_insert(next);
-                if *id == next {
+                let new;
+                (*id, new) = self.weld.index(p);
+                if new {
                     vertex_line(&mut self.vertices, p).map_err(|e| Error::io(&self.path, e))?;
                 }
             }
