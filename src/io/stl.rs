@@ -151,21 +151,17 @@ fn parse_binary(data: &[u8], n: usize) -> std::result::Result<Parsed, String> {
     // n is bounded by the file size here (checked by the caller).
     let f = |rec: &[u8], o: usize| f32::from_le_bytes([rec[o], rec[o + 1], rec[o + 2], rec[o + 3]]);
     let records = &data[84..];
-    // One pass over the records, each writing its own slots.
-    let mut normals = vec![[0f32; 3]; n];
-    let mut corners = vec![[0f32; 3]; 3 * n];
-    records
+    let normals: Vec<[f32; 3]> = records
         .par_chunks_exact(50)
-        .zip(normals.par_iter_mut())
-        .zip(corners.par_chunks_exact_mut(3))
-        .for_each(|((r, nrm), c)| {
-            *nrm = [f(r, 0), f(r, 4), f(r, 8)];
-            for (k, p) in c.iter_mut().enumerate() {
-                *p = [f(r, 12 + 12 * k), f(r, 16 + 12 * k), f(r, 20 + 12 * k)];
-            }
-        });
+        .map(|r| [f(r, 0), f(r, 4), f(r, 8)])
+        .collect();
+    // Corners straight from the records: corner k of facet i at bytes 12 + 12k of record i.
+    let facet = |i: usize| {
+        let r = &records[50 * i + 12..50 * i + 48];
+        [0, 12, 24].map(|o| [f(r, o), f(r, o + 4), f(r, o + 8)])
+    };
     Ok(Parsed {
-        mesh: super::weld::weld_corners(&corners)?,
+        mesh: super::weld::weld_facets_by(n, facet)?,
         normals: Some(normals),
         ..Parsed::default()
     })

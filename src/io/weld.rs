@@ -100,44 +100,142 @@ impl ExactWelder {
     }
 }
 
-/// Welds a triangle soup given corner by corner (three per facet), in parallel: corners are
-/// dealt to a fixed number of shards by hash, each shard welds its own with a hash map, and the
-/// shards' vertices are numbered one shard after another (deterministic, whatever the thread
-/// count). Non-finite coordinates are an error naming the facet.
+/// Welds a triangle soup given corner by corner (three per facet): [`weld_facets_by`].
 pub fn weld_corners(corners: &[[f32; 3]]) -> Result<Mesh, String> {
-    use rayon::prelude::*;
-    const SHARDS: usize = 8;
-    if let Some(i) = corners
-        .par_iter()
-        .position_first(|p| !p.iter().all(|v| v.is_finite()))
-    {
+    if !corners.len().is_multiple_of(3) {
         return Err(format!(
-            "facet {}: non-finite vertex coordinate {:?}",
-            i / 3 + 1,
-            corners[i]
+            "{} corners do not make whole facets",
+            corners.len()
         ));
     }
-    let shard: Vec<u8> = corners
-        .par_iter()
-        .map(|&p| ((FastHash.hash_one(key(p)) >> 40) % SHARDS as u64) as u8)
+    weld_facets_by(corners.len() / 3, |f| {
+        [corners[3 * f], corners[3 * f + 1], corners[3 * f + 2]]
+    })
+}
+
+/// Shards of the parallel weld: enough that each shard's map stays in a core's cache.
+const SHARDS: usize = 64;
+/// Corners per chunk in the weld's partitioning passes (whole facets).
+const CHUNK: usize = 3 << 14;
+
+/// One corner on its way to its shard: its position's bits and its index.
+#[derive(Clone, Copy, Default)]
+struct Entry {
+    key_lo: u64,
+    key_hi: u32,
+    corner: u32,
+}
+
+/// A chunk of corners partitioned by shard.
+struct Chunk {
+    /// Shard of each corner of the chunk, in corner order.
+    shard: Vec<u8>,
+    /// The chunk's corners grouped by shard, in corner order within each group.
+    entries: Vec<Entry>,
+    /// Where each shard's group starts in `entries`, and the end.
+    starts: [u32; SHARDS + 1],
+}
+
+/// Welds a triangle soup of `facets` facets, `facet(f)` giving the corners of each, in
+/// parallel: corners are dealt to [`SHARDS`] shards by the hash of their position's bits
+/// (partitioned chunk by chunk, so every pass reads and writes memory in order), each shard
+/// welds its own with a hash map small enough to stay in cache, and the shards' vertices are
+/// numbered one shard after another, each shard's in the order of their first corners
+/// (deterministic, whatever the thread count). Non-finite coordinates are an error naming the
+/// facet.
+pub fn weld_facets_by(
+    facets: usize,
+    facet: impl Fn(usize) -> [[f32; 3]; 3] + Sync,
+) -> Result<Mesh, String> {
+    use rayon::prelude::*;
+    let count = 3 * facets;
+    if count >= u32::MAX as usize {
+        return Err("more than 2^32 corners".into());
+    }
+    let corner = |c: usize| facet(c / 3)[c % 3];
+    let n_chunks = count.div_ceil(CHUNK);
+    let chunk_range = |j: usize| j * CHUNK..((j + 1) * CHUNK).min(count);
+    // 1. Partition each chunk by shard (u8::MAX marks a non-finite corner).
+    let chunks: Vec<Chunk> = (0..n_chunks)
+        .into_par_iter()
+        .map(|j| {
+            let range = chunk_range(j);
+            let mut keys = Vec::with_capacity(range.len());
+            let mut shard = Vec::with_capacity(range.len());
+            let mut starts = [0u32; SHARDS + 1];
+            for f in range.start / 3..range.end / 3 {
+                for p in facet(f) {
+                    let k = key(p);
+                    let s = if p.iter().all(|v| v.is_finite()) {
+                        ((FastHash.hash_one(k) >> 40) % SHARDS as u64) as u8
+                    } else {
+                        u8::MAX
+                    };
+                    keys.push(k);
+                    shard.push(s);
+                    if s != u8::MAX {
+                        starts[s as usize + 1] += 1;
+                    }
+                }
+            }
+            for s in 0..SHARDS {
+                starts[s + 1] += starts[s];
+            }
+            let mut next = starts;
+            let mut entries = vec![Entry::default(); starts[SHARDS] as usize];
+            for ((c, &k), &s) in range.zip(&keys).zip(&shard) {
+                if s != u8::MAX {
+                    entries[next[s as usize] as usize] = Entry {
+                        key_lo: k as u64,
+                        key_hi: (k >> 64) as u32,
+                        corner: c as u32,
+                    };
+                    next[s as usize] += 1;
+                }
+            }
+            Chunk {
+                shard,
+                entries,
+                starts,
+            }
+        })
         .collect();
+    if let Some(c) = chunks.par_iter().enumerate().find_map_first(|(j, ch)| {
+        ch.shard
+            .iter()
+            .position(|&s| s == u8::MAX)
+            .map(|i| j * CHUNK + i)
+    }) {
+        return Err(format!(
+            "facet {}: non-finite vertex coordinate {:?}",
+            c / 3 + 1,
+            corner(c)
+        ));
+    }
+    // 2. Each shard welds its corners, chunk after chunk: a vertex id (within the shard) per
+    //    corner, and the first corner of each vertex.
     let parts: Vec<(Vec<u32>, Vec<u32>)> = (0..SHARDS)
         .into_par_iter()
         .map(|s| {
+            let total: usize = chunks
+                .iter()
+                .map(|ch| (ch.starts[s + 1] - ch.starts[s]) as usize)
+                .sum();
+            // A closed triangle mesh has about six corners per vertex; the map grows if not.
             let mut map: FastMap<u128, u32> =
-                HashMap::with_capacity_and_hasher(corners.len() / (2 * SHARDS) + 16, FastHash);
-            let mut ids = Vec::with_capacity(corners.len() / SHARDS + 16);
+                HashMap::with_capacity_and_hasher(total / 4 + 16, FastHash);
+            let mut ids = Vec::with_capacity(total);
             let mut firsts = Vec::new();
-            for (c, &sh) in shard.iter().enumerate() {
-                if sh as usize != s {
-                    continue;
+            for ch in &chunks {
+                for e in &ch.entries[ch.starts[s] as usize..ch.starts[s + 1] as usize] {
+                    let next = firsts.len() as u32;
+                    let k = e.key_lo as u128 | (e.key_hi as u128) << 64;
+                    let id = *map.entry(k).or_insert(next);
+                    if id == next {
+                        firsts.push(e.corner);
+                    }
+                    ids.push(id);
                 }
-                let next = firsts.len() as u32;
-                let id = *map.entry(key(corners[c])).or_insert(next);
-                if id == next {
-                    firsts.push(c as u32);
-                }
-                ids.push(id);
             }
             (ids, firsts)
         })
@@ -146,19 +244,47 @@ pub fn weld_corners(corners: &[[f32; 3]]) -> Result<Mesh, String> {
     for s in 0..SHARDS {
         offset[s + 1] = offset[s] + parts[s].1.len() as u32;
     }
-    let mut cursor = [0usize; SHARDS];
-    let mut indices = Vec::with_capacity(corners.len());
-    for &sh in &shard {
-        let s = sh as usize;
-        indices.push(offset[s] + parts[s].0[cursor[s]]);
-        cursor[s] += 1;
-    }
-    let mut positions = Vec::with_capacity(3 * offset[SHARDS] as usize);
-    for (_, firsts) in &parts {
-        for &c in firsts {
-            positions.extend_from_slice(&corners[c as usize]);
+    // 3. Each corner's vertex, chunk by chunk: within a chunk, a shard's corners come in order,
+    //    so a cursor per shard walks that shard's ids.
+    let mut base = Vec::with_capacity(n_chunks);
+    let mut running = [0u32; SHARDS];
+    for ch in &chunks {
+        base.push(running);
+        for (s, r) in running.iter_mut().enumerate() {
+            *r += ch.starts[s + 1] - ch.starts[s];
         }
     }
+    let mut indices = vec![0u32; count];
+    indices
+        .par_chunks_mut(CHUNK)
+        .zip(chunks.par_iter())
+        .zip(base.par_iter())
+        .for_each(|((out, ch), base)| {
+            let mut cursor = *base;
+            for (o, &s) in out.iter_mut().zip(&ch.shard) {
+                let s = s as usize;
+                *o = offset[s] + parts[s].0[cursor[s] as usize];
+                cursor[s] += 1;
+            }
+        });
+    drop(chunks);
+    // 4. Positions, shard by shard.
+    let mut positions = vec![0f32; 3 * offset[SHARDS] as usize];
+    let mut slices = Vec::with_capacity(SHARDS);
+    let mut rest = &mut positions[..];
+    for (_, firsts) in &parts {
+        let (head, tail) = rest.split_at_mut(3 * firsts.len());
+        slices.push(head);
+        rest = tail;
+    }
+    slices
+        .into_par_iter()
+        .zip(parts.par_iter())
+        .for_each(|(out, (_, firsts))| {
+            for (o, &c) in out.chunks_exact_mut(3).zip(firsts) {
+                o.copy_from_slice(&corner(c as usize));
+            }
+        });
     Ok(Mesh { positions, indices })
 }
 
@@ -281,5 +407,51 @@ mod tests {
         let b = w.vertex([-0.0, 1.0, 2.0]).unwrap();
         assert_eq!(a, b);
         assert!(w.vertex([f32::NAN, 0.0, 0.0]).is_err());
+    }
+
+    #[test]
+    fn parallel_soup_weld_matches_a_sequential_one() {
+        // A soup over several chunks: positions drawn from a small set (with −0 beside +0), so
+        // most corners repeat one seen in another chunk and shard.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let corners: Vec<[f32; 3]> = (0..3 * 70_000)
+            .map(|_| {
+                let r = next();
+                let v = [
+                    (r % 37) as f32,
+                    ((r >> 8) % 41) as f32,
+                    ((r >> 16) % 43) as f32,
+                ];
+                if r >> 40 & 1 == 1 && v[0] == 0.0 {
+                    [-0.0, v[1], v[2]]
+                } else {
+                    v
+                }
+            })
+            .collect();
+        let mesh = weld_corners(&corners).unwrap();
+        // Every corner maps to its own position, and no two vertices share one.
+        for (c, &i) in corners.iter().zip(&mesh.indices) {
+            let p = &mesh.positions[3 * i as usize..3 * i as usize + 3];
+            assert_eq!(key([p[0], p[1], p[2]]), key(*c));
+        }
+        let mut seq = ExactWelder::new(0);
+        for &c in &corners {
+            seq.corner(c).unwrap();
+        }
+        assert_eq!(mesh.vertex_count(), seq.mesh.vertex_count());
+        // Again, the same numbering.
+        assert_eq!(weld_corners(&corners).unwrap().indices, mesh.indices);
+
+        let mut bad = corners.clone();
+        bad[3 * 60_000 + 2] = [1.0, f32::INFINITY, 0.0];
+        let e = weld_corners(&bad).unwrap_err();
+        assert!(e.starts_with("facet 60001:"), "{e}");
     }
 }
