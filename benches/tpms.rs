@@ -8,7 +8,8 @@
 //! 3. Calibration alone, for every type and structure at density 0.30, in a fresh process each
 //!    (so the per-process sample tables are built inside the timing, as a CLI run pays them).
 //!
-//! Run: `cargo bench --bench tpms` (add `-- --runs N` to change the repeat count).
+//! Run: `cargo bench --bench tpms` (add `-- --runs N` to change the repeat count, `-- --section K`
+//! to run section K alone).
 
 use std::path::Path;
 use std::process::Command;
@@ -54,6 +55,12 @@ fn measure(exe: &str, args: &[&str], out: &Path, runs: usize) -> (f64, f64, serd
             .stdout(std::process::Stdio::null());
         let (s, m, code) = run_measured(&mut c);
         assert_eq!(code, 0, "latvox {} failed", args.join(" "));
+        let rep: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        println!(
+            "    run: wall {s:.2} s, peak RSS {m:.0} MB, write stage {:.2} s",
+            rep["timings"]["write"].as_f64().unwrap_or(f64::NAN)
+        );
         walls.push(s);
         rss.push(m);
     }
@@ -75,6 +82,12 @@ fn main() {
         .map(|n| n.get())
         .unwrap_or(1);
     println!("machine: {threads} threads; {runs} runs per case, median reported");
+    let section = args
+        .iter()
+        .position(|a| a == "--section")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse::<u32>().ok());
+    let run_section = |k: u32| section.is_none_or(|s| s == k);
 
     let gyroid = [
         "tpms",
@@ -86,91 +99,97 @@ fn main() {
         "0.3",
         "--quiet",
     ];
-    for (label, extra) in [
-        (
-            "full pipeline (CGAL checks incl. self-intersection)",
-            vec![],
-        ),
-        (
-            "without the self-intersection test",
-            vec!["--no-self-intersection-check"],
-        ),
-    ] {
-        let mut args = gyroid.to_vec();
-        args.extend(["--cells", "10", "--cell-size", "5", "--resolution", "32"]);
-        args.extend(extra);
-        let out = dir.path().join("g10.stl");
-        let (wall, rss, rep) = measure(exe, &args, &out, runs);
-        println!(
+    if run_section(1) {
+        for (label, extra) in [
+            (
+                "full pipeline (CGAL checks incl. self-intersection)",
+                vec![],
+            ),
+            (
+                "without the self-intersection test",
+                vec!["--no-self-intersection-check"],
+            ),
+        ] {
+            let mut args = gyroid.to_vec();
+            args.extend(["--cells", "10", "--cell-size", "5", "--resolution", "32"]);
+            args.extend(extra);
+            let out = dir.path().join("g10.stl");
+            let (wall, rss, rep) = measure(exe, &args, &out, runs);
+            println!(
             "gyroid net 0.30, 10x10x10 cells, 320^3 grid, {label}: wall {wall:.2} s (median), peak RSS {rss:.0} MB; {} triangles, STL {:.0} MB, achieved density {:.5}",
             rep["triangles"],
             std::fs::metadata(&out).unwrap().len() as f64 / 1e6,
             rep["achieved_density"].as_f64().unwrap()
         );
-        println!("  stage times of the last run (s): {}", rep["timings"]);
+            println!("  stage times of the last run (s): {}", rep["timings"]);
+        }
     }
-
-    println!("scale: gyroid net 0.30, 16 voxels per cell, 5 mm cells, STL or 3MF written:");
-    for (label, cells, file, extra) in [
-        ("10x10x10 cells, instanced, STL", "10", "s.stl", vec![]),
-        ("30x30x30 cells, instanced, STL", "30", "s.stl", vec![]),
-        ("30x30x30 cells, instanced, 3MF", "30", "s.3mf", vec![]),
-        (
-            "10x10x10 cells, whole part meshed at once",
-            "10",
-            "s.stl",
-            vec!["--no-instancing"],
-        ),
-        (
-            "10x10x10 cells, tiles for a 64 MB budget",
-            "10",
-            "s.stl",
-            vec!["--no-instancing", "--memory", "64M"],
-        ),
-    ] {
-        let mut args = gyroid.to_vec();
-        args.extend(["--cells", cells, "--cell-size", "5", "--resolution", "16"]);
-        args.extend(extra);
-        let out = dir.path().join(file);
-        let (wall, rss, rep) = measure(exe, &args, &out, runs);
-        println!(
+    if run_section(2) {
+        println!("scale: gyroid net 0.30, 16 voxels per cell, 5 mm cells, STL or 3MF written:");
+        for (label, cells, file, extra) in [
+            ("10x10x10 cells, instanced, STL", "10", "s.stl", vec![]),
+            ("30x30x30 cells, instanced, STL", "30", "s.stl", vec![]),
+            ("30x30x30 cells, instanced, 3MF", "30", "s.3mf", vec![]),
+            (
+                "10x10x10 cells, whole part meshed at once",
+                "10",
+                "s.stl",
+                vec!["--no-instancing"],
+            ),
+            (
+                "10x10x10 cells, tiles for a 64 MB budget",
+                "10",
+                "s.stl",
+                vec!["--no-instancing", "--memory", "64M"],
+            ),
+        ] {
+            let mut args = gyroid.to_vec();
+            args.extend(["--cells", cells, "--cell-size", "5", "--resolution", "16"]);
+            args.extend(extra);
+            let out = dir.path().join(file);
+            let (wall, rss, rep) = measure(exe, &args, &out, runs);
+            println!(
             "  {label}: wall {wall:.2} s, peak RSS {rss:.0} MB (medians); {} triangles, file {:.0} MB, achieved density {:.5}",
             rep["triangles"],
             std::fs::metadata(&out).unwrap().len() as f64 / 1e6,
             rep["achieved_density"].as_f64().unwrap()
         );
-        let _ = std::fs::remove_file(&out);
+            let _ = std::fs::remove_file(&out);
+        }
     }
-
-    println!("calibration alone (density 0.30, 32 voxels per cell, 3x3x3 cells, fresh process):");
-    for t in ["p", "gyroid", "d", "iwp", "s", "frd", "neovius"] {
-        for st in ["net", "sheet"] {
-            let mut cal = Vec::new();
-            let report = dir.path().join("c.json");
-            for _ in 0..runs {
-                let mut c = Command::new(exe);
-                c.args(["tpms", "--type", t, "--structure", st, "--density", "0.3"])
-                    .args([
-                        "--cells",
-                        "3",
-                        "--cell-size",
-                        "5",
-                        "--quiet",
-                        "--allow-islands",
-                    ])
-                    .arg("-o")
-                    .arg(dir.path().join("c.stl"))
-                    .arg("--report")
-                    .arg(&report)
-                    .stdout(std::process::Stdio::null())
-                    .stderr(std::process::Stdio::null());
-                let (_, _, code) = run_measured(&mut c);
-                assert!(code == 0 || code == 1, "latvox failed on {t} {st}");
-                let rep: serde_json::Value =
-                    serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
-                cal.push(rep["timings"]["calibrate"].as_f64().unwrap() * 1e3);
+    if run_section(3) {
+        println!(
+            "calibration alone (density 0.30, 32 voxels per cell, 3x3x3 cells, fresh process):"
+        );
+        for t in ["p", "gyroid", "d", "iwp", "s", "frd", "neovius"] {
+            for st in ["net", "sheet"] {
+                let mut cal = Vec::new();
+                let report = dir.path().join("c.json");
+                for _ in 0..runs {
+                    let mut c = Command::new(exe);
+                    c.args(["tpms", "--type", t, "--structure", st, "--density", "0.3"])
+                        .args([
+                            "--cells",
+                            "3",
+                            "--cell-size",
+                            "5",
+                            "--quiet",
+                            "--allow-islands",
+                        ])
+                        .arg("-o")
+                        .arg(dir.path().join("c.stl"))
+                        .arg("--report")
+                        .arg(&report)
+                        .stdout(std::process::Stdio::null())
+                        .stderr(std::process::Stdio::null());
+                    let (_, _, code) = run_measured(&mut c);
+                    assert!(code == 0 || code == 1, "latvox failed on {t} {st}");
+                    let rep: serde_json::Value =
+                        serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+                    cal.push(rep["timings"]["calibrate"].as_f64().unwrap() * 1e3);
+                }
+                println!("  {t:8} {st:6} calibration {:.1} ms (median)", median(cal));
             }
-            println!("  {t:8} {st:6} calibration {:.1} ms (median)", median(cal));
         }
     }
 }
