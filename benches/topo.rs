@@ -13,23 +13,13 @@ use std::path::Path;
 use std::process::Command;
 use std::time::Instant;
 
+#[path = "../tests/common/child.rs"]
+mod child;
+
+/// (wall seconds, peak RSS in MB, exit code) of one run of `cmd`.
 fn run_measured(cmd: &mut Command) -> (f64, f64, i32) {
-    let start = Instant::now();
-    let child = cmd.spawn().expect("spawn latvox");
-    let pid = child.id() as libc::pid_t;
-    let mut status = 0;
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    // SAFETY: plain wait4 on our own child; `usage` is a valid out-pointer.
-    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
-    assert_eq!(r, pid, "wait4 failed");
-    let secs = start.elapsed().as_secs_f64();
-    std::mem::forget(child);
-    let code = if libc::WIFEXITED(status) {
-        libc::WEXITSTATUS(status)
-    } else {
-        -1
-    };
-    (secs, usage.ru_maxrss as f64 / 1024.0, code)
+    let m = child::run_measured(cmd);
+    (m.seconds, m.peak_rss_mb(), m.code)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

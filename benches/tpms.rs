@@ -13,25 +13,14 @@
 
 use std::path::Path;
 use std::process::Command;
-use std::time::Instant;
 
+#[path = "../tests/common/child.rs"]
+mod child;
+
+/// (wall seconds, peak RSS in MB, exit code) of one run of `cmd`.
 fn run_measured(cmd: &mut Command) -> (f64, f64, i32) {
-    let start = Instant::now();
-    let child = cmd.spawn().expect("spawn latvox");
-    let pid = child.id() as libc::pid_t;
-    let mut status = 0;
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    // SAFETY: plain wait4 on our own child; `usage` is a valid out-pointer.
-    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
-    assert_eq!(r, pid, "wait4 failed");
-    let secs = start.elapsed().as_secs_f64();
-    std::mem::forget(child);
-    let code = if libc::WIFEXITED(status) {
-        libc::WEXITSTATUS(status)
-    } else {
-        -1
-    };
-    (secs, usage.ru_maxrss as f64 / 1024.0, code)
+    let m = child::run_measured(cmd);
+    (m.seconds, m.peak_rss_mb(), m.code)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -66,6 +55,16 @@ fn measure(exe: &str, args: &[&str], out: &Path, runs: usize) -> (f64, f64, serd
     }
     let rep = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
     (median(walls), median(rss), rep)
+}
+
+/// The written part in one line: triangles, file size, achieved density.
+fn part(rep: &serde_json::Value, out: &Path) -> String {
+    format!(
+        "{} triangles, file {:.0} MB, achieved density {:.5}",
+        rep["triangles"],
+        std::fs::metadata(out).unwrap().len() as f64 / 1e6,
+        rep["achieved_density"].as_f64().unwrap()
+    )
 }
 
 fn main() {
@@ -116,11 +115,9 @@ fn main() {
             let out = dir.path().join("g10.stl");
             let (wall, rss, rep) = measure(exe, &args, &out, runs);
             println!(
-            "gyroid net 0.30, 10x10x10 cells, 320^3 grid, {label}: wall {wall:.2} s (median), peak RSS {rss:.0} MB; {} triangles, STL {:.0} MB, achieved density {:.5}",
-            rep["triangles"],
-            std::fs::metadata(&out).unwrap().len() as f64 / 1e6,
-            rep["achieved_density"].as_f64().unwrap()
-        );
+                "gyroid net 0.30, 10x10x10 cells, 320^3 grid, {label}: wall {wall:.2} s (median), peak RSS {rss:.0} MB; {}",
+                part(&rep, &out)
+            );
             println!("  stage times of the last run (s): {}", rep["timings"]);
         }
     }
@@ -149,11 +146,9 @@ fn main() {
             let out = dir.path().join(file);
             let (wall, rss, rep) = measure(exe, &args, &out, runs);
             println!(
-            "  {label}: wall {wall:.2} s, peak RSS {rss:.0} MB (medians); {} triangles, file {:.0} MB, achieved density {:.5}",
-            rep["triangles"],
-            std::fs::metadata(&out).unwrap().len() as f64 / 1e6,
-            rep["achieved_density"].as_f64().unwrap()
-        );
+                "  {label}: wall {wall:.2} s, peak RSS {rss:.0} MB (medians); {}",
+                part(&rep, &out)
+            );
             let _ = std::fs::remove_file(&out);
         }
     }

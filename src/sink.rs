@@ -11,9 +11,9 @@
 use crate::error::{Error, Result};
 use crate::field::Aabb;
 use crate::io::stl::StlFormat;
+use crate::io::weld::ExactIndex;
 use crate::mesh::Mesh;
 use rayon::prelude::*;
-use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -235,26 +235,11 @@ impl MeshSink for StlSink {
     }
 }
 
-/// Exact welding: one index per distinct corner (`+0.0` and `-0.0` are one), numbered in the
-/// order corners first arrive.
-#[derive(Default)]
-struct ExactWeld(HashMap<[u32; 3], u32>);
-
-impl ExactWeld {
-    /// The corner's index, and whether it is new.
-    fn index(&mut self, p: &[f32; 3]) -> (u32, bool) {
-        let key = p.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
-        let next = self.0.len() as u32;
-        let id = *self.0.entry(key).or_insert(next);
-        (id, id == next)
-    }
-}
-
 /// Gathers streamed triangles into an indexed mesh, welding bit-identical corners.
 #[derive(Default)]
 pub struct MeshCollector {
     pub mesh: Mesh,
-    weld: ExactWeld,
+    weld: ExactIndex,
 }
 
 impl MeshSink for MeshCollector {
@@ -268,7 +253,7 @@ impl MeshSink for MeshCollector {
     fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
         for t in batch {
             for p in t {
-                let (id, new) = self.weld.index(p);
+                let (id, new) = self.weld.index(*p);
                 if new {
                     self.mesh.positions.extend_from_slice(p);
                 }
@@ -291,7 +276,7 @@ pub struct ThreeMfSink {
     path: PathBuf,
     vertices: std::io::BufWriter<std::fs::File>,
     triangles: std::io::BufWriter<std::fs::File>,
-    weld: ExactWeld,
+    weld: ExactIndex,
 }
 
 impl ThreeMfSink {
@@ -307,7 +292,7 @@ impl ThreeMfSink {
             path: path.to_path_buf(),
             vertices: scratch()?,
             triangles: scratch()?,
-            weld: ExactWeld::default(),
+            weld: ExactIndex::default(),
         })
     }
 
@@ -367,7 +352,7 @@ impl MeshSink for ThreeMfSink {
             let mut ids = [0u32; 3];
             for (id, p) in ids.iter_mut().zip(t) {
                 let new;
-                (*id, new) = self.weld.index(p);
+                (*id, new) = self.weld.index(*p);
                 if new {
                     vertex_line(&mut self.vertices, p).map_err(|e| Error::io(&self.path, e))?;
                 }

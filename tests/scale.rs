@@ -10,24 +10,13 @@ use std::io::Read;
 
 /// Runs latvox with `args` in `dir`; returns (exit code, peak RSS in bytes) from wait4.
 fn run_measured(args: &[&str], dir: &std::path::Path) -> (i32, u64) {
-    let child = latvox()
-        .args(args)
-        .current_dir(dir)
-        .stdout(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut status = 0;
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    // SAFETY: wait4 on our own child with valid out-pointers.
-    let r = unsafe { libc::wait4(child.id() as libc::pid_t, &mut status, 0, &mut usage) };
-    assert_eq!(r, child.id() as libc::pid_t);
-    std::mem::forget(child);
-    let code = if libc::WIFEXITED(status) {
-        libc::WEXITSTATUS(status)
-    } else {
-        -1
-    };
-    (code, usage.ru_maxrss as u64 * 1024)
+    let m = common::child::run_measured(
+        latvox()
+            .args(args)
+            .current_dir(dir)
+            .stdout(std::process::Stdio::null()),
+    );
+    (m.code, m.peak_rss)
 }
 
 /// Streams a binary STL: (triangles, enclosed volume).

@@ -278,7 +278,6 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
     sink.finish()
 }
 
-/// Writes a 3MF package with one mesh object and one build item.
 /// The package's fixed parts, and the model XML up to its first vertex / after its last triangle.
 pub(crate) const CONTENT_TYPES: &[u8] = br#"<?xml version="1.0" encoding="UTF-8"?>
 <Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types"><Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/><Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/></Types>
@@ -312,6 +311,7 @@ pub(crate) fn triangle_line(w: &mut dyn Write, t: &[u32]) -> std::io::Result<()>
     )
 }
 
+/// Writes a 3MF package with one mesh object and one build item.
 pub fn write(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
     if let Some(t) = mesh
         .indices

@@ -57,9 +57,37 @@ fn key(p: [f32; 3]) -> u128 {
     b[0] as u128 | (b[1] as u128) << 32 | (b[2] as u128) << 64
 }
 
+/// Exact vertex numbering: one id per distinct position (`+0.0` and `-0.0` are one), numbered
+/// in the order positions first arrive.
+#[derive(Default)]
+pub struct ExactIndex(FastMap<u128, u32>);
+
+impl ExactIndex {
+    /// `capacity`: expected number of distinct positions (a hint only).
+    pub fn with_capacity(capacity: usize) -> Self {
+        ExactIndex(HashMap::with_capacity_and_hasher(capacity, FastHash))
+    }
+
+    /// Distinct positions so far.
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+
+    /// The id of position `p`, and whether it is new.
+    pub fn index(&mut self, p: [f32; 3]) -> (u32, bool) {
+        let next = self.0.len() as u32;
+        let id = *self.0.entry(key(p)).or_insert(next);
+        (id, id == next)
+    }
+}
+
 /// Builds a mesh corner by corner, merging bit-identical positions.
 pub struct ExactWelder {
-    map: FastMap<u128, u32>,
+    index: ExactIndex,
     pub mesh: Mesh,
     /// Corners seen (each `corner` call).
     pub corners: u64,
@@ -69,7 +97,7 @@ impl ExactWelder {
     /// `capacity`: expected number of distinct vertices (a hint only; never trust file headers).
     pub fn new(capacity: usize) -> Self {
         ExactWelder {
-            map: HashMap::with_capacity_and_hasher(capacity, FastHash),
+            index: ExactIndex::with_capacity(capacity),
             mesh: Mesh::default(),
             corners: 0,
         }
@@ -80,12 +108,11 @@ impl ExactWelder {
         if !p.iter().all(|v| v.is_finite()) {
             return Err(format!("non-finite vertex coordinate {p:?}"));
         }
-        let next = self.map.len();
-        if next >= u32::MAX as usize {
+        if self.index.len() >= u32::MAX as usize {
             return Err("more than 2^32 vertices".into());
         }
-        let id = *self.map.entry(key(p)).or_insert(next as u32);
-        if id as usize == next {
+        let (id, new) = self.index.index(p);
+        if new {
             self.mesh.positions.extend_from_slice(&p);
         }
         Ok(id)
@@ -98,19 +125,6 @@ impl ExactWelder {
         self.corners += 1;
         Ok(())
     }
-}
-
-/// Welds a triangle soup given corner by corner (three per facet): [`weld_facets_by`].
-pub fn weld_corners(corners: &[[f32; 3]]) -> Result<Mesh, String> {
-    if !corners.len().is_multiple_of(3) {
-        return Err(format!(
-            "{} corners do not make whole facets",
-            corners.len()
-        ));
-    }
-    weld_facets_by(corners.len() / 3, |f| {
-        [corners[3 * f], corners[3 * f + 1], corners[3 * f + 2]]
-    })
 }
 
 /// Shards of the parallel weld: enough that each shard's map stays in a core's cache.
@@ -435,7 +449,10 @@ mod tests {
                 }
             })
             .collect();
-        let mesh = weld_corners(&corners).unwrap();
+        let weld = |c: &[[f32; 3]]| {
+            weld_facets_by(c.len() / 3, |f| [c[3 * f], c[3 * f + 1], c[3 * f + 2]])
+        };
+        let mesh = weld(&corners).unwrap();
         // Every corner maps to its own position, and no two vertices share one.
         for (c, &i) in corners.iter().zip(&mesh.indices) {
             let p = &mesh.positions[3 * i as usize..3 * i as usize + 3];
@@ -447,11 +464,11 @@ mod tests {
         }
         assert_eq!(mesh.vertex_count(), seq.mesh.vertex_count());
         // Again, the same numbering.
-        assert_eq!(weld_corners(&corners).unwrap().indices, mesh.indices);
+        assert_eq!(weld(&corners).unwrap().indices, mesh.indices);
 
         let mut bad = corners.clone();
         bad[3 * 60_000 + 2] = [1.0, f32::INFINITY, 0.0];
-        let e = weld_corners(&bad).unwrap_err();
+        let e = weld(&bad).unwrap_err();
         assert!(e.starts_with("facet 60001:"), "{e}");
     }
 }

@@ -85,13 +85,7 @@ impl Lattice {
     /// Samples, meshes and snaps the lattice on voxels of size `voxel`, with voxel cells tiling
     /// the box from its lower corner.
     pub fn mesh(&self, voxel: f64, adaptivity: f64) -> Result<(Mesh, MeshingStats)> {
-        self.mesh_on(
-            GridSpec::covering(&self.bounds, voxel, HALF_WIDTH),
-            adaptivity,
-        )
-    }
-
-    pub(crate) fn mesh_on(&self, spec: GridSpec, adaptivity: f64) -> Result<(Mesh, MeshingStats)> {
+        let spec = GridSpec::covering(&self.bounds, voxel, HALF_WIDTH);
         let (keyed, stats) = self.mesh_keyed(spec, adaptivity)?;
         Ok((keyed.to_mesh(), stats))
     }

@@ -2,6 +2,8 @@
 //! volume by the divergence theorem, and the seed's TPMS formulas written out directly.
 #![allow(dead_code)]
 
+pub mod child;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
