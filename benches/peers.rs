@@ -214,6 +214,7 @@ fn child(a: &[String]) {
                 instancing: true,
                 tile: None,
                 memory: None,
+                keep_fragments: false,
             };
             let mut sink =
                 latvox::sink::StlSink::create(&stl, latvox::io::StlFormat::Binary).unwrap();

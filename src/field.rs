@@ -50,6 +50,21 @@ pub trait Field: Sync {
     }
 }
 
+impl<T: Field + ?Sized> Field for &T {
+    fn value(&self, p: Vec3) -> f64 {
+        (**self).value(p)
+    }
+    fn clearance(&self, p: Vec3) -> f64 {
+        (**self).clearance(p)
+    }
+    fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
+        (**self).implicit_with_gradient(p)
+    }
+    fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
+        (**self).sample_block(origin, h, out)
+    }
+}
+
 /// An axis-aligned box `[min, max]`, as an exact signed distance field.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Aabb {

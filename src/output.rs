@@ -23,7 +23,22 @@ pub fn check_writable(path: &Path) -> Result<()> {
         .prefix(".latvox-probe-")
         .tempfile_in(dir)
         .map(drop)
-        .map_err(|e| Error::io(path, e))
+        .map_err(|e| folder_error(path, e))
+}
+
+/// The error of creating a file in `path`'s folder, naming the user's path (not the temporary
+/// file's) and the folder when it is missing.
+fn folder_error(path: &Path, e: std::io::Error) -> Error {
+    let dir = parent_dir(path);
+    if !dir.is_dir() {
+        return Error::invalid(format!(
+            "{}: the folder {} does not exist",
+            path.display(),
+            dir.display()
+        ));
+    }
+    // tempfile's message names the temporary file: keep only what went wrong.
+    Error::io(path, std::io::Error::from(e.kind()))
 }
 
 /// Ordinary file permissions (0666 less the umask), not the temporary file's private 0600.
@@ -57,7 +72,7 @@ pub fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile> {
         .rand_bytes(RANDOM_LEN)
         .permissions(file_mode())
         .tempfile_in(parent_dir(path))
-        .map_err(|e| Error::io(path, e))
+        .map_err(|e| folder_error(path, e))
 }
 
 /// Length of the random part of a temporary's name (tempfile's default).

@@ -436,3 +436,116 @@ fn report_holds_every_field_and_progress_stays_off_pipes() {
         "{stdout}"
     );
 }
+
+/// Comma lists that start with a minus are values, not flags: `--origin -3,2,1` places the box
+/// there (the written part's bounds start at the origin).
+#[test]
+fn a_negative_origin_is_a_value_not_a_flag() {
+    let dir = tempdir();
+    let out = run(
+        &[
+            "tpms",
+            "--cells",
+            "1",
+            "--cell-size",
+            "4",
+            "-r",
+            "16",
+            "--origin",
+            "-3,2,-1.5",
+            "-q",
+            "-o",
+            "o.stl",
+        ],
+        dir.path(),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (lo, hi) = bounds(&read_stl(&dir.path().join("o.stl")));
+    for (a, (&l, &h)) in lo.iter().zip(&hi).enumerate() {
+        let o = [-3.0, 2.0, -1.5][a];
+        assert!(
+            (l - o).abs() < 1e-5 && (h - o - 4.0).abs() < 1e-5,
+            "{lo:?} {hi:?}"
+        );
+    }
+    // A negative value where a positive one is needed is named as such, not as a flag.
+    let out = run(&["tpms", "--cell-size", "-5", "-q"], dir.path());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(err.contains("positive"), "{err}");
+}
+
+/// The summary prints numbers for people: the cell counts of a box of partial cells rounded,
+/// not `1.8199999999999998`.
+#[test]
+fn the_summary_rounds_its_numbers() {
+    let dir = tempdir();
+    let out = run(
+        &[
+            "tpms",
+            "--size",
+            "9.1,7,5",
+            "--cell-size",
+            "5",
+            "-r",
+            "12",
+            "-q",
+            "-o",
+            "s.stl",
+        ],
+        dir.path(),
+    );
+    assert_eq!(out.status.code(), Some(0));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let first = stdout.lines().next().unwrap();
+    assert!(first.contains("1.82×1.4×1 cells of 5 mm"), "{first}");
+    // No number anywhere in the summary carries float noise.
+    assert!(
+        !stdout.contains("9999") && !stdout.contains("0000000"),
+        "{stdout}"
+    );
+}
+
+/// Writing into a folder that does not exist names the user's path and that folder, not a
+/// temporary file's.
+#[test]
+fn a_missing_folder_is_named_as_the_user_gave_it() {
+    let dir = tempdir();
+    for args in [
+        vec![
+            "tpms",
+            "--cells",
+            "1",
+            "-q",
+            "-o",
+            "no-such-folder/part.stl",
+        ],
+        vec![
+            "tpms",
+            "--cells",
+            "1",
+            "-q",
+            "-o",
+            "p.stl",
+            "--report",
+            "no-such-folder/r.json",
+        ],
+    ] {
+        let out = run(&args, dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains("no-such-folder/"), "{err}");
+        assert!(err.contains("does not exist"), "{err}");
+        assert!(
+            !err.contains("latvox-probe") && !err.contains(".latvox-"),
+            "{err}"
+        );
+        assert!(files_in(dir.path()).is_empty());
+    }
+}

@@ -47,19 +47,19 @@ pub struct TpmsArgs {
     #[arg(long, value_name = "net|sheet", default_value = "net", value_parser = parse_structure)]
     pub structure: Structure,
     /// Target volume fraction of solid, in (0, 1).
-    #[arg(long, short = 'd', default_value_t = 0.3, value_parser = parse_density)]
+    #[arg(long, short = 'd', default_value_t = 0.3, value_parser = parse_density, allow_hyphen_values = true)]
     pub density: f64,
     /// Cells per axis: N or NX,NY,NZ.
-    #[arg(long, value_name = "N[,NY,NZ]", value_parser = parse_counts)]
+    #[arg(long, value_name = "N[,NY,NZ]", value_parser = parse_counts, allow_hyphen_values = true)]
     pub cells: Option<[u32; 3]>,
     /// Cell size in mm: A or AX,AY,AZ.
-    #[arg(long, value_name = "MM[,MM,MM]", value_parser = parse_positive3)]
+    #[arg(long, value_name = "MM[,MM,MM]", value_parser = parse_positive3, allow_hyphen_values = true)]
     pub cell_size: Option<[f64; 3]>,
     /// Overall box size in mm (with --cells or --cell-size): S or SX,SY,SZ.
-    #[arg(long, value_name = "MM[,MM,MM]", value_parser = parse_positive3)]
+    #[arg(long, value_name = "MM[,MM,MM]", value_parser = parse_positive3, allow_hyphen_values = true)]
     pub size: Option<[f64; 3]>,
     /// Lower corner of the box in mm (lattice phase starts there).
-    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,0", value_parser = parse_finite3)]
+    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,0", value_parser = parse_finite3, allow_hyphen_values = true)]
     pub origin: [f64; 3],
     /// Voxels per cell along the cell's shortest side.
     #[arg(long, short = 'r', default_value_t = 32, value_parser = clap::value_parser!(u32).range(4..=4096))]
@@ -103,6 +103,10 @@ pub struct TpmsArgs {
     /// part's size; the tiled part is the same solid as the untiled one.
     #[arg(long, value_name = "VOXELS", value_parser = parse_tile)]
     pub tile: Option<i64>,
+    /// Keep the pieces the box cuts loose from the lattice (by default they are removed, so
+    /// that the part is one piece; the summary and report count them either way).
+    #[arg(long)]
+    pub keep_fragments: bool,
 }
 
 pub(crate) fn parse_surface(s: &str) -> std::result::Result<Surface, String> {
@@ -166,6 +170,7 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
         instancing: !a.no_instancing,
         tile: a.tile,
         memory: a.memory,
+        keep_fragments: a.keep_fragments,
     };
     latvox::output::check_writable(&a.output)?;
     let format = if a.ascii {
@@ -181,26 +186,42 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
     Ok(report)
 }
 
-/// Whether the part passed CGAL's checks (those that were asked for).
+/// Whether the part passed: CGAL's checks (those that were asked for), the density, and one
+/// piece (unless fragments were kept on purpose).
 pub fn passed(r: &TpmsReport) -> bool {
-    r.checks.is_valid_solid()
-        || !r.checks.self_intersection_checked && r.checks.closed && r.checks.outward
+    let solid = r.checks.is_valid_solid()
+        || !r.checks.self_intersection_checked && r.checks.closed && r.checks.outward;
+    let one_piece = r.one_piece != Some(false) || !r.fragments.removed && r.fragments.count > 0;
+    solid && r.density_met && one_piece
+}
+
+/// A number for people: at most `digits` decimals, trailing zeros dropped.
+fn human(x: f64, digits: usize) -> String {
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
 }
 
 fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
     let c = &r.checks;
+    let triple = |v: [f64; 3]| {
+        if v[0] == v[1] && v[1] == v[2] {
+            human(v[0], 3)
+        } else {
+            v.map(|x| human(x, 3)).join("×")
+        }
+    };
+    let cells = r.cells.map(|x| human(x, 2)).join("×");
     println!(
-        "{} {} · {}×{}×{} cells of {}×{}×{} mm · {} voxels/cell ({:.4} mm)",
+        "{} {} · {cells} cells of {} mm · {} voxels/cell ({} mm)",
         r.surface.name(),
         r.structure.name(),
-        r.cells[0],
-        r.cells[1],
-        r.cells[2],
-        r.cell_size[0],
-        r.cell_size[1],
-        r.cell_size[2],
+        triple(r.cell_size),
         r.resolution,
-        r.voxel_size
+        human(r.voxel_size, 4)
     );
     println!(
         "density   target {:.4}  achieved {:.4}  (error {:+.5}, level t = {:.5})",
@@ -219,6 +240,27 @@ fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
             b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]
         );
     }
+    let f = &r.fragments;
+    println!(
+        "pieces    {}",
+        match r.one_piece {
+            None => "not checked (meshed in tiles without a template of its cells)".to_string(),
+            Some(true) if f.count == 0 => "one".to_string(),
+            Some(true) => format!(
+                "one ({} fragment{} cut loose by the box removed, {:.3} mm³)",
+                f.count,
+                if f.count == 1 { "" } else { "s" },
+                f.volume
+            ),
+            Some(false) => format!(
+                "{} ({} fragment{} kept, {:.3} mm³)",
+                f.count + 1,
+                f.count,
+                if f.count == 1 { "" } else { "s" },
+                f.volume
+            ),
+        }
+    );
     println!(
         "CGAL      closed {}  outward {}  manifold {}  self-intersections {}",
         yes(c.closed),

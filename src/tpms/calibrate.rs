@@ -419,6 +419,9 @@ pub struct Calibration {
     pub predicted_fraction: f64,
     /// Unit-cell meshings performed.
     pub meshings: u32,
+    /// Whether the meshed cell's fraction came within reach of the target (on voxels too
+    /// coarse for the lattice's members it jumps past it).
+    pub converged: bool,
     pub seconds: f64,
 }
 
@@ -515,6 +518,7 @@ pub fn calibrate(
     let fa = ca - ia;
     let predict = |i: f64| i + k * fa;
     let (mut ta, mut pa) = (t0, predict(ia));
+    let mut converged = false;
     // Meshing biases the fraction by nearly the same amount at nearby levels (the exact
     // fraction is smooth in the level, see `Table::fraction`): each step reads the level off
     // the exact cell's distribution at the target less the bias last measured. A step whose
@@ -527,12 +531,14 @@ pub fn calibrate(
         if (pa - target).abs() < ACCEPT {
             ia += target - pa;
             (ta, pa) = (tb, target);
+            converged = true;
             break;
         }
         ia = interior(tb)?;
         meshings += 1;
         (ta, pa) = (tb, predict(ia));
     }
+    converged |= (pa - target).abs() < ACCEPT;
     Ok(Calibration {
         level: ta,
         analytic_level: t0,
@@ -540,6 +546,7 @@ pub fn calibrate(
         face_effect: fa,
         predicted_fraction: pa,
         meshings,
+        converged,
         seconds: start.elapsed().as_secs_f64(),
     })
 }

@@ -1,17 +1,21 @@
-//! One TPMS job, start to finish: check the request, calibrate, mesh, verify, and report.
+//! One TPMS job, start to finish: check the request, calibrate a first level, find the level
+//! that gives *this* part its density (raising the resolution when the voxels are too coarse to
+//! reach it), mesh, verify, write and report — the meshing itself is [`crate::pipeline`]'s.
 
 use super::calibrate::{self, Calibration, Connectivity, FeasibleRange};
-use super::instance::{self, Template};
-use super::{Domain, Lattice, MeshingStats, Structure, Surface};
+use super::{Domain, Lattice, LatticeFamily, MeshingStats, Structure, Surface};
 use crate::error::{Error, Result};
 use crate::field::Aabb;
-use crate::grid::{GridSpec, IndexBox};
+use crate::instance;
 use crate::mesh::Mesh;
+use crate::pieces::Fragments;
+use crate::pipeline::{self, Options, Route, Solved, PROMISE};
 use crate::progress::Progress;
-use crate::sink::{Measures, MeshCollector, MeshSink, Triangle};
-use crate::tile;
-use crate::verify::{verify, verify_on, Verification};
+use crate::sink::{MeshCollector, MeshSink};
+use crate::verify::Verification;
 use std::time::Instant;
+
+pub use crate::pipeline::{Instancing, Tiling, DEFAULT_MEMORY};
 
 /// Sheet walls thinner than this many voxels are not represented faithfully by a narrow band
 /// (samples miss the wall and it perforates); the resolution is raised to keep them this thick.
@@ -43,6 +47,8 @@ pub struct TpmsJob {
     /// Memory budget, bytes: parts whose grid would not fit are meshed in tiles sized from it
     /// ([`DEFAULT_MEMORY`] when not given).
     pub memory: Option<u64>,
+    /// Keep the fragments the box cuts loose from the lattice (removed by default).
+    pub keep_fragments: bool,
 }
 
 /// Timings per stage, seconds.
@@ -58,33 +64,26 @@ pub struct Timings {
     pub total: f64,
 }
 
-/// How the part was meshed when it was copied from a template (see [`instance`]).
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct Instancing {
-    /// Cells of the part per axis that the template stands for (1 along axes not copied).
-    pub part_cells: [i64; 3],
-    /// Cells of the template per axis.
-    pub template_cells: [i64; 3],
-    pub template_triangles: u64,
-    /// CGAL's checks ran on the template, which holds every kind of cell the part has; the
-    /// part is written as exact copies of its cells.
-    pub verified: &'static str,
+/// How the level of the part was found: the part (or a template of its cells) meshed at each
+/// level tried, and the volume fraction measured.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct LevelSearch {
+    /// What was measured: `part` (the whole part), `template` (a template of its cells, which
+    /// gives the part's volume) or `tiles` (the part meshed tile by tile, not kept).
+    pub measured_on: &'static str,
+    /// `[level, volume fraction]` of each meshing, in order.
+    pub tried: Vec<[f64; 2]>,
+    /// Resolutions tried before the one used, with the closest fraction each could give.
+    pub coarser: Vec<ResolutionMiss>,
 }
 
-/// How the part was meshed when it was meshed in tiles (see [`crate::tile`]).
+/// A resolution at which no level gave the target density.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct Tiling {
-    pub tiles: u64,
-    /// Tile edge, samples.
-    pub tile_samples: i64,
-    /// Samples meshed around each tile and not kept.
-    pub margin_samples: i64,
-    pub verified: &'static str,
+pub struct ResolutionMiss {
+    pub resolution: u32,
+    /// The closest volume fraction found.
+    pub closest: f64,
 }
-
-/// Memory a part may use while it is meshed when no budget is given: larger parts are meshed
-/// in tiles.
-pub const DEFAULT_MEMORY: u64 = 4 << 30;
 
 /// The JSON report of a TPMS job.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -98,7 +97,10 @@ pub struct TpmsReport {
     /// triangles exactly as written) over the box volume.
     pub achieved_density: f64,
     pub density_error: f64,
+    /// Whether the written mesh is within 0.002 of the target density.
+    pub density_met: bool,
     pub calibration: Calibration,
+    pub level_search: LevelSearch,
     pub feasible_range: FeasibleRange,
     pub connectivity: Connectivity,
     pub resolution_requested: u32,
@@ -117,6 +119,11 @@ pub struct TpmsReport {
     pub bounding_box: Option<Aabb>,
     /// CGAL's checks: on the written mesh, or on the template when `instancing` is set.
     pub checks: Verification,
+    /// Pieces of the lattice the box cut loose: removed (unless kept with `keep_fragments`).
+    pub fragments: Fragments,
+    /// Whether what was written is one piece (`null` where it was not checked: a part meshed in
+    /// tiles without a template of its cells).
+    pub one_piece: Option<bool>,
     pub instancing: Option<Instancing>,
     pub tiling: Option<Tiling>,
     pub meshing: MeshingStats,
@@ -192,86 +199,202 @@ impl TpmsJob {
         }
 
         let cell = self.domain.cell;
-        let min_cell = cell.iter().cloned().fold(f64::INFINITY, f64::min);
-        let mut resolution = self.resolution;
-        let mut wall = None;
-        if st == Structure::Sheet {
-            let w = calibrate::thinnest_sheet_wall(s, t0) * resolution as f64;
-            if w < MIN_WALL_VOXELS {
-                let needed = (resolution as f64 * MIN_WALL_VOXELS / w).ceil() as u32;
-                if !self.auto_resolution {
-                    return Err(Error::invalid(format!(
-                        "the {} sheet's walls at density {} are {w:.2} voxels thin at resolution {resolution}; use --resolution {needed} or more",
-                        s.name(),
-                        self.density
-                    )));
-                }
-                // Raised to whole 8-voxel blocks, so that cells can still be copied exactly.
-                let raised = needed.div_ceil(instance::BLOCK) * instance::BLOCK;
-                warnings.push(format!(
-                    "resolution raised from {resolution} to {raised} voxels per cell: sheet walls were {w:.2} voxels thin"
-                ));
-                resolution = raised;
-            }
-            wall = Some(calibrate::thinnest_sheet_wall(s, t0) * resolution as f64);
+        let opts = Options {
+            adaptivity: self.adaptivity,
+            self_intersection: self.self_intersection,
+            instancing: self.instancing,
+            tile: self.tile,
+            memory: self.memory,
+            // Islands asked for are kept: the solid is meant to fall apart.
+            keep_fragments: self.keep_fragments || !conn.solid,
+        };
+        // Sheet walls thinner than MIN_WALL_VOXELS perforate; a resolution that leaves them so
+        // is passed over without meshing.
+        let wall_at = |r: u32| {
+            (st == Structure::Sheet).then(|| calibrate::thinnest_sheet_wall(s, t0) * r as f64)
+        };
+        // The level is found on the part at the requested resolution; where the walls are too
+        // thin or no level reaches the target on these voxels, finer ones are searched (steps
+        // that double, then bisection), and the smallest that works is used (or, with a fixed
+        // resolution, named in the refusal).
+        let mut passed_over: Vec<String> = Vec::new();
+        let mut start_at = self.resolution;
+        if let Some(w) = wall_at(start_at).filter(|&w| w < MIN_WALL_VOXELS) {
+            let needed = (start_at as f64 * MIN_WALL_VOXELS / w).ceil() as u32;
+            passed_over.push(format!(
+                "sheet walls were {w:.2} voxels thin at {start_at} voxels per cell"
+            ));
+            // Raised to whole 8-voxel blocks, so that cells can still be copied exactly; a
+            // refusal names the smallest that works.
+            start_at = if self.auto_resolution {
+                needed.div_ceil(instance::BLOCK) * instance::BLOCK
+            } else {
+                needed
+            };
         }
-        let voxel = min_cell / resolution as f64;
-
-        let cal = {
-            let _p = progress.stage("calibrating");
-            calibrate::calibrate(
-                s,
-                st,
-                self.density,
-                cell,
-                voxel,
-                self.domain.counts(),
-                self.adaptivity,
-            )?
+        let limit = max_resolution(self.resolution).max(start_at);
+        let mut coarser = Vec::new();
+        let mut calibrate_seconds = table_seconds;
+        let mut attempt = |r: u32| -> Result<Option<Found>> {
+            let _p = progress.stage(if r == self.resolution {
+                "calibrating and meshing"
+            } else {
+                "searching for a resolution that reaches the density"
+            });
+            let (cal_seconds, outcome) = self.attempt(r, &opts)?;
+            calibrate_seconds += cal_seconds;
+            Ok(match outcome {
+                Ok(found) => Some(found),
+                Err(closest) => {
+                    coarser.push(ResolutionMiss {
+                        resolution: r,
+                        closest,
+                    });
+                    None
+                }
+            })
         };
-        let bounds = self.domain.bounds();
-        let lattice = Lattice {
-            surface: s,
-            structure: st,
-            level: cal.level,
-            cell,
-            bounds,
-            phase: bounds.min,
-        };
-        let route = self.route(&lattice, voxel);
-        let written = match route {
-            Route::Instanced(plan) => {
-                self.write_instanced(&lattice, voxel, plan, progress, sink)?
+        let found = match attempt(start_at)? {
+            Some(f) => f,
+            None => {
+                let mut lo = start_at;
+                let mut step = (start_at / 4).max(1);
+                let mut best = loop {
+                    if lo >= limit {
+                        let closest = coarser.last().map_or(f64::NAN, |m| m.closest);
+                        return Err(Error::invalid(format!(
+                            "no level gives the {} {} a density of {} within {PROMISE} at {} to {limit} voxels per cell (closest {closest:.4}); the box may cut the lattice into pieces",
+                            s.name(),
+                            st.name(),
+                            self.density,
+                            self.resolution,
+                        )));
+                    }
+                    let r = (lo + step).min(limit);
+                    match attempt(r)? {
+                        Some(f) => break f,
+                        None => {
+                            lo = r;
+                            step *= 2;
+                        }
+                    }
+                };
+                while best.resolution - lo > 1 {
+                    let mid = lo + (best.resolution - lo) / 2;
+                    match attempt(mid)? {
+                        Some(f) => best = f,
+                        None => lo = mid,
+                    }
+                }
+                best
             }
-            Route::Tiled(edge) => self.write_tiled(&lattice, voxel, edge, progress, sink)?,
-            Route::Whole => self.write_whole(&lattice, voxel, progress, sink)?,
         };
-        let Written {
+        coarser.sort_by_key(|m| m.resolution);
+        if let Some(miss) = coarser.first().filter(|m| m.resolution == start_at) {
+            passed_over.push(format!(
+                "at {} voxels per cell no level gives density {} (closest {:.4}): the voxels are too coarse for the lattice's members",
+                miss.resolution, self.density, miss.closest
+            ));
+        }
+        let Found {
+            resolution,
+            voxel,
+            cal,
+            family,
+            route,
+            solved,
+        } = found;
+        if let Some(why) = passed_over.first() {
+            if !self.auto_resolution {
+                return Err(Error::invalid(format!(
+                    "the {} {} at density {}: {why}; use --resolution {resolution}, the smallest that works",
+                    s.name(),
+                    st.name(),
+                    self.density
+                )));
+            }
+            warnings.push(format!(
+                "resolution raised from {} to {resolution} voxels per cell: {why}",
+                self.resolution
+            ));
+        }
+        let wall = wall_at(resolution);
+        let bounds = self.domain.bounds();
+        let Solved {
+            best,
+            tried,
+            meshing: search_meshing,
+            ..
+        } = solved;
+        let level = best.level;
+        let measured_on = match (&best.made, route) {
+            (pipeline::Made::Whole(_), _) => "part",
+            (_, Route::Tiled(_, None)) => "tiles",
+            _ => "template",
+        };
+        let pipeline::Written {
             checks,
             meshing,
             measures,
             vertices,
+            fragments,
             instancing,
             tiling,
             verify_seconds,
             write_seconds,
-        } = written;
+        } = pipeline::write(&family, best, voxel, route, &opts, progress, sink)?;
+        // The meshings of the search are part of the work (the whole route's last one is the
+        // part's own mesh).
+        let mut all_meshing = search_meshing;
+        if !matches!(route, Route::Whole(None)) {
+            all_meshing.add(&meshing);
+        }
         let volume = measures.volume;
         let achieved = volume / bounds.volume();
+        let density_met = (achieved - self.density).abs() <= PROMISE;
+        if !density_met {
+            warnings.push(format!(
+                "the written mesh's density {achieved:.4} misses the target {} by more than {PROMISE}: please report this",
+                self.density
+            ));
+        }
         if !checks.is_valid_solid() && (checks.self_intersection_checked || !checks.closed) {
             warnings.push(
                 "CGAL did not find the mesh a valid closed, outward, self-intersection-free solid"
                     .into(),
             );
         }
+        let one_piece = match route {
+            Route::Tiled(_, None) => None,
+            _ => Some(fragments.count == 0 || fragments.removed),
+        };
+        if fragments.count > 0 {
+            warnings.push(format!(
+                "{} fragment{} cut loose by the box ({:.3} mm³) {}",
+                fragments.count,
+                if fragments.count == 1 { "" } else { "s" },
+                fragments.volume,
+                if fragments.removed {
+                    "removed"
+                } else {
+                    "kept: they are not joined to the part"
+                }
+            ));
+        }
         Ok(TpmsReport {
             surface: s,
             structure: st,
-            level: cal.level,
+            level,
             target_density: self.density,
             achieved_density: achieved,
             density_error: achieved - self.density,
+            density_met,
             calibration: cal,
+            level_search: LevelSearch {
+                measured_on,
+                tried: tried.iter().map(|&(t, f)| [t, f]).collect(),
+                coarser,
+            },
             feasible_range: range,
             connectivity: conn,
             resolution_requested: self.resolution,
@@ -287,229 +410,90 @@ impl TpmsJob {
             volume: Some(volume),
             bounding_box: (measures.triangles > 0).then_some(measures.bounds),
             checks,
+            fragments,
+            one_piece,
             instancing,
             tiling,
             timings: Timings {
-                calibrate: table_seconds + cal.seconds,
-                sample: meshing.sample_seconds,
-                mesh: meshing.mesh_seconds,
-                snap: meshing.snap_seconds,
+                calibrate: calibrate_seconds,
+                sample: all_meshing.sample_seconds,
+                mesh: all_meshing.mesh_seconds,
+                snap: all_meshing.snap_seconds,
                 verify: verify_seconds,
                 write: write_seconds,
                 total: start.elapsed().as_secs_f64(),
             },
-            meshing,
+            meshing: all_meshing,
             warnings,
             output: None,
         })
     }
-}
 
-/// How a part is meshed.
-enum Route {
-    /// Copied cell by cell from a meshed template.
-    Instanced([instance::AxisPlan; 3]),
-    /// Meshed tile by tile, tiles of this many samples a side.
-    Tiled(i64),
-    /// Meshed at once.
-    Whole,
-}
-
-/// What writing the part gave.
-struct Written {
-    checks: Verification,
-    meshing: MeshingStats,
-    measures: Measures,
-    vertices: u64,
-    instancing: Option<Instancing>,
-    tiling: Option<Tiling>,
-    verify_seconds: f64,
-    write_seconds: f64,
-}
-
-impl TpmsJob {
-    fn route(&self, lattice: &Lattice, voxel: f64) -> Route {
-        if self.adaptivity != 0.0 {
-            return Route::Whole;
-        }
-        if self.instancing && self.tile.is_none() {
-            if let Some(plan) = instance::plan(self.domain.size, lattice.cell, voxel) {
-                return Route::Instanced(plan);
-            }
-        }
-        if let Some(edge) = self.tile {
-            return Route::Tiled(edge);
-        }
-        let spec = GridSpec::covering(&lattice.bounds, voxel, super::HALF_WIDTH);
-        let budget = self.memory.unwrap_or(DEFAULT_MEMORY);
-        if spec.padded_region().voxels() * tile::BYTES_PER_VOXEL > budget {
-            Route::Tiled(tile::tile_edge_for_budget(budget))
-        } else {
-            Route::Whole
-        }
-    }
-
-    fn write_instanced(
+    /// Calibrates a first level at `resolution` and searches the level for the part from it:
+    /// the part found, or the closest fraction when no level on these voxels gives the target
+    /// (the unit cell's calibration not converging is enough to tell, without meshing the
+    /// part). Returns the calibration's time too.
+    fn attempt(
         &self,
-        lattice: &Lattice,
-        voxel: f64,
-        plan: [instance::AxisPlan; 3],
-        progress: &Progress,
-        sink: &mut dyn MeshSink,
-    ) -> Result<Written> {
-        let (template, meshing) = {
-            let _p = progress.stage("sampling and meshing the template");
-            Template::build(lattice, voxel, plan)?
-        };
-        // CGAL checks the template while the part is written: the two share the cores.
-        let template_mesh = template.mesh.to_mesh();
-        let (checks, verify_seconds, measures, write_seconds) = {
-            let _p = progress.stage("writing the part and verifying its template");
-            std::thread::scope(|scope| {
-                let checker = scope.spawn(|| {
-                    let t = Instant::now();
-                    let r = verify_on(&template_mesh, self.self_intersection, false);
-                    (r, t.elapsed().as_secs_f64())
-                });
-                let t = Instant::now();
-                let measures = template.expand(sink);
-                let write_seconds = t.elapsed().as_secs_f64();
-                let (checks, verify_seconds) =
-                    checker.join().expect("the CGAL check does not panic");
-                (checks, verify_seconds, measures, write_seconds)
-            })
-        };
-        Ok(Written {
-            checks: checks?,
-            meshing,
-            measures: measures?,
-            vertices: template.vertex_count(),
-            instancing: Some(Instancing {
-                part_cells: plan.map(|a| a.n),
-                template_cells: plan.map(|a| a.m),
-                template_triangles: template.mesh.triangle_count() as u64,
-                verified: "template",
-            }),
-            tiling: None,
-            verify_seconds,
-            write_seconds,
-        })
-    }
-
-    fn write_tiled(
-        &self,
-        lattice: &Lattice,
-        voxel: f64,
-        edge: i64,
-        progress: &Progress,
-        sink: &mut dyn MeshSink,
-    ) -> Result<Written> {
-        let spec = GridSpec::covering(&lattice.bounds, voxel, super::HALF_WIDTH);
-        let stats = std::sync::Mutex::new(MeshingStats::default());
-        let mesh_tile = |r: IndexBox| {
-            let (m, s) = lattice.mesh_keyed_in(spec, Some(r), 0.0)?;
-            let mut total = stats.lock().expect("no panic while holding the lock");
-            total.add(&s);
-            Ok(m)
-        };
-        let t = Instant::now();
-        let out = {
-            let _p = progress.stage("meshing and writing the part tile by tile");
-            tile::mesh_tiled(
-                spec.padded_region(),
-                edge,
-                &mesh_tile,
-                self.self_intersection,
-                sink,
-            )?
-        };
-        let closed = out.bad_edges == 0;
-        let m = out.measures;
-        Ok(Written {
-            checks: Verification {
-                manifold: closed,
-                closed,
-                outward: closed && m.volume > 0.0,
-                self_intersection_checked: out.self_intersection_checked,
-                self_intersecting: out.self_intersecting,
-                volume: closed.then_some(m.volume),
-                area: m.area,
-                faces: m.triangles,
-                vertices: out.vertices,
-                border_edges: out.bad_edges,
-                components: 0,
+        resolution: u32,
+        opts: &Options,
+    ) -> Result<(f64, std::result::Result<Found, f64>)> {
+        let cell = self.domain.cell;
+        let min_cell = cell.iter().cloned().fold(f64::INFINITY, f64::min);
+        let voxel = min_cell / resolution as f64;
+        let cal = calibrate::calibrate(
+            self.surface,
+            self.structure,
+            self.density,
+            cell,
+            voxel,
+            self.domain.counts(),
+            self.adaptivity,
+        )?;
+        if !cal.converged {
+            return Ok((cal.seconds, Err(cal.predicted_fraction)));
+        }
+        let bounds = self.domain.bounds();
+        let family = LatticeFamily {
+            part: Lattice {
+                surface: self.surface,
+                structure: self.structure,
+                level: cal.level,
+                cell,
+                bounds,
+                phase: bounds.min,
             },
-            meshing: stats.into_inner().expect("no panic while holding the lock"),
-            measures: m,
-            vertices: out.vertices,
-            instancing: None,
-            tiling: Some(Tiling {
-                tiles: out.tiles,
-                tile_samples: edge,
-                margin_samples: tile::MARGIN,
-                verified: "per tile: edges counted by latvox, self-intersection by CGAL",
+        };
+        let route = Route::choose(&family.part, voxel, opts);
+        let solved = pipeline::solve(&family, self.density, cal.level, voxel, route, opts)?;
+        if !solved.met {
+            return Ok((cal.seconds, Err(solved.best.fraction)));
+        }
+        Ok((
+            cal.seconds,
+            Ok(Found {
+                resolution,
+                voxel,
+                cal,
+                family,
+                route,
+                solved,
             }),
-            verify_seconds: 0.0,
-            write_seconds: t.elapsed().as_secs_f64(),
-        })
-    }
-
-    fn write_whole(
-        &self,
-        lattice: &Lattice,
-        voxel: f64,
-        progress: &Progress,
-        sink: &mut dyn MeshSink,
-    ) -> Result<Written> {
-        let (mesh, meshing) = {
-            let _p = progress.stage("sampling and meshing");
-            lattice.mesh(voxel, self.adaptivity)?
-        };
-        let t = Instant::now();
-        let checks = {
-            let _p = progress.stage("verifying with CGAL");
-            verify(&mesh, self.self_intersection)?
-        };
-        let verify_seconds = t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let measures = {
-            let _p = progress.stage("writing the part");
-            write_mesh(&mesh, sink)?
-        };
-        Ok(Written {
-            checks,
-            meshing,
-            measures,
-            vertices: mesh.vertex_count() as u64,
-            instancing: None,
-            tiling: None,
-            verify_seconds,
-            write_seconds: t.elapsed().as_secs_f64(),
-        })
+        ))
     }
 }
 
-/// Streams an in-memory mesh into `sink` in batches, measuring it on the way.
-fn write_mesh(mesh: &Mesh, sink: &mut dyn MeshSink) -> Result<Measures> {
-    use rayon::prelude::*;
-    sink.begin(Some(mesh.triangle_count() as u64))?;
-    let mut measures = Measures::default();
-    const BATCH: usize = 1 << 16;
-    for start in (0..mesh.triangle_count()).step_by(BATCH) {
-        let end = (start + BATCH).min(mesh.triangle_count());
-        let tris: Vec<Triangle> = (start..end)
-            .into_par_iter()
-            .map(|t| {
-                let i = &mesh.indices[3 * t..3 * t + 3];
-                [i[0], i[1], i[2]].map(|v| {
-                    let p = &mesh.positions[3 * v as usize..3 * v as usize + 3];
-                    [p[0], p[1], p[2]]
-                })
-            })
-            .collect();
-        measures = measures.merged(&Measures::of(&tris));
-        sink.triangles(&tris)?;
-    }
-    sink.finish()?;
-    Ok(measures)
+/// A resolution at which the part reaches its density, with the level found.
+struct Found {
+    resolution: u32,
+    voxel: f64,
+    cal: Calibration,
+    family: LatticeFamily,
+    route: Route,
+    solved: Solved,
+}
+
+/// The finest resolution tried before a part is refused.
+fn max_resolution(requested: u32) -> u32 {
+    (4 * requested).max(64)
 }

@@ -1,15 +1,14 @@
 //! TPMS lattices: a surface, a structure, a target volume fraction and a box, to a closed mesh
 //! whose volume fraction is the target.
 //!
-//! Pipeline: [`calibrate`] the level on the unit cell → sample the lattice clipped by its box into
-//! an OpenVDB narrow band ([`crate::grid`]) → mesh with volumeToMesh → [`crate::snap`] vertices
-//! onto the exact surface and box edges → verify with CGAL ([`crate::verify`]).
+//! Pipeline: [`calibrate`] the level on the unit cell (a first guess) → [`crate::pipeline`]:
+//! sample the lattice clipped by its box into an OpenVDB narrow band, mesh, snap, measure the
+//! part and correct the level until its density is the target, verify with CGAL, write.
 //!
 //! The lattice's phase is anchored at the box's lower corner, and the voxel size divides the
 //! cell, so every whole cell of the part is meshed exactly like the calibration's unit cell.
 
 pub mod calibrate;
-pub mod instance;
 pub mod job;
 pub mod surface;
 
@@ -18,14 +17,12 @@ pub use job::{TpmsJob, TpmsReport};
 pub use surface::{Structure, Surface, TpmsField};
 
 use crate::error::{Error, Result};
-use crate::extract::KeyedMesh;
-use crate::field::{Aabb, Intersection, Vec3};
-use crate::grid::{Grid, GridSpec, IndexBox};
+use crate::field::{Aabb, Field, Vec3};
+use crate::grid::GridSpec;
 use crate::mesh::Mesh;
-use crate::snap::SnapStats;
+use crate::pipeline::{mesh_keyed, Family, Solid};
 
-/// Default narrow-band half width, voxels.
-pub const HALF_WIDTH: f64 = 3.0;
+pub use crate::pipeline::{MeshingStats, HALF_WIDTH};
 
 /// A TPMS lattice clipped by a box: everything needed to mesh it, at a known level.
 #[derive(Debug, Clone, Copy)]
@@ -39,35 +36,6 @@ pub struct Lattice {
     pub bounds: Aabb,
     /// A lattice point (the phase), mm: the box's lower corner for a part.
     pub phase: Vec3,
-}
-
-/// Statistics of one meshing pass.
-#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
-pub struct MeshingStats {
-    pub voxel_size: f64,
-    pub blocks_tested: u64,
-    pub blocks_sampled: u64,
-    pub active_voxels: u64,
-    pub grid_bytes: u64,
-    pub snap: SnapStats,
-    pub sample_seconds: f64,
-    pub mesh_seconds: f64,
-    pub snap_seconds: f64,
-}
-
-impl MeshingStats {
-    /// Adds another pass's counts and times (tiles of one part).
-    pub fn add(&mut self, o: &MeshingStats) {
-        self.voxel_size = o.voxel_size;
-        self.blocks_tested += o.blocks_tested;
-        self.blocks_sampled += o.blocks_sampled;
-        self.active_voxels += o.active_voxels;
-        self.grid_bytes = self.grid_bytes.max(o.grid_bytes);
-        self.snap += o.snap;
-        self.sample_seconds += o.sample_seconds;
-        self.mesh_seconds += o.mesh_seconds;
-        self.snap_seconds += o.snap_seconds;
-    }
 }
 
 impl Lattice {
@@ -86,88 +54,59 @@ impl Lattice {
     /// the box from its lower corner.
     pub fn mesh(&self, voxel: f64, adaptivity: f64) -> Result<(Mesh, MeshingStats)> {
         let spec = GridSpec::covering(&self.bounds, voxel, HALF_WIDTH);
-        let (keyed, stats) = self.mesh_keyed(spec, adaptivity)?;
+        let (keyed, stats) = mesh_keyed(self, spec, None, adaptivity, None)?;
         Ok((keyed.to_mesh(), stats))
-    }
-
-    /// Samples, meshes and snaps the lattice on `spec`, keeping each vertex's key.
-    pub(crate) fn mesh_keyed(
-        &self,
-        spec: GridSpec,
-        adaptivity: f64,
-    ) -> Result<(KeyedMesh, MeshingStats)> {
-        self.mesh_keyed_in(spec, None, adaptivity)
-    }
-
-    /// [`Lattice::mesh_keyed`] on the blocks covering `region` only (a tile), or on the whole
-    /// padded grid.
-    pub(crate) fn mesh_keyed_in(
-        &self,
-        spec: GridSpec,
-        region: Option<IndexBox>,
-        adaptivity: f64,
-    ) -> Result<(KeyedMesh, MeshingStats)> {
-        self.mesh_keyed_snapped(spec, region, adaptivity, None)
     }
 
     /// Volume of the solid inside `b`, a box within the bounds: only the vertices of triangles
     /// that can reach into `b` (within two voxels of it) are snapped.
     pub(crate) fn volume_in(&self, spec: GridSpec, adaptivity: f64, b: &Aabb) -> Result<f64> {
         let within = b.grown(2.0 * spec.voxel);
-        let (keyed, _) = self.mesh_keyed_snapped(spec, None, adaptivity, Some(&within))?;
+        let (keyed, _) = mesh_keyed(self, spec, None, adaptivity, Some(&within))?;
         Ok(keyed.to_mesh().volume_in_box(b))
     }
+}
 
-    fn mesh_keyed_snapped(
-        &self,
-        spec: GridSpec,
-        region: Option<IndexBox>,
-        adaptivity: f64,
-        snap_within: Option<&Aabb>,
-    ) -> Result<(KeyedMesh, MeshingStats)> {
-        use std::time::Instant;
-        let tpms = self
-            .field(spec.half_width * spec.voxel)
-            .with_periodic_samples(spec.voxel);
-        let solid = Intersection {
-            a: tpms,
-            b: self.bounds,
-        };
-        let t = Instant::now();
-        let grid = match region {
-            Some(r) => Grid::sample_box(&solid, spec, r)?,
-            None => Grid::sample(&solid, spec)?,
-        };
-        let sample_seconds = t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let mut keyed = if adaptivity == 0.0 {
-            KeyedMesh::extract(&grid)?
-        } else {
-            KeyedMesh::from_adaptive(&grid.to_mesh(adaptivity)?, &spec)
-        };
-        let mesh_seconds = t.elapsed().as_secs_f64();
-        let stats = MeshingStats {
-            voxel_size: spec.voxel,
-            blocks_tested: grid.blocks_tested,
-            blocks_sampled: grid.blocks_sampled,
-            active_voxels: grid.active_voxels(),
-            grid_bytes: grid.memory_bytes(),
-            sample_seconds,
-            mesh_seconds,
-            ..Default::default()
-        };
-        drop(grid);
-        let t = Instant::now();
-        let snap_stats =
-            crate::snap::snap_within(&mut keyed, &tpms, &self.bounds, &spec, snap_within);
-        Ok((
-            keyed,
-            MeshingStats {
-                snap: snap_stats,
-                snap_seconds: t.elapsed().as_secs_f64(),
-                ..stats
-            },
-        ))
+impl Solid for Lattice {
+    fn field(&self, spec: &GridSpec) -> Box<dyn Field + '_> {
+        Box::new(
+            Lattice::field(self, spec.half_width * spec.voxel).with_periodic_samples(spec.voxel),
+        )
+    }
+
+    fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    fn with_bounds(&self, bounds: Aabb) -> Self {
+        Lattice { bounds, ..*self }
+    }
+
+    fn period(&self) -> Option<Vec3> {
+        (self.phase == self.bounds.min).then_some(self.cell)
+    }
+}
+
+/// A TPMS part at every level: the family the pipeline searches for the part's density.
+#[derive(Debug, Clone, Copy)]
+pub struct LatticeFamily {
+    /// The part at some level (the level is replaced).
+    pub part: Lattice,
+}
+
+impl Family for LatticeFamily {
+    type Solid = Lattice;
+
+    fn at(&self, level: f64) -> Lattice {
+        Lattice { level, ..self.part }
+    }
+
+    fn model_fraction(&self, level: f64) -> f64 {
+        calibrate::analytic_fraction(self.part.surface, self.part.structure, level)
+    }
+
+    fn model_level(&self, fraction: f64) -> f64 {
+        calibrate::analytic_level(self.part.surface, self.part.structure, fraction)
     }
 }
 

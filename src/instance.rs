@@ -1,6 +1,6 @@
-//! Instancing: a periodic lattice is meshed once, at template size, and copied cell by cell.
+//! Instancing: a periodic solid is meshed once, at template size, and copied cell by cell.
 //!
-//! Away from the box, every cell of a TPMS lattice is the same cell. A cell's mesh depends only
+//! Away from the box, every cell of a periodic lattice (TPMS, struts) is the same cell. A cell's mesh depends only
 //! on whether it touches the box's lower face, its upper face, or neither, along each axis — so
 //! a part of n cells per axis contains only the kinds of cell that a part of three cells per axis
 //! contains (four when the last cell is cut short: the full cell before it is a kind of its own).
@@ -9,8 +9,8 @@
 //! copy of the template cell of its kind, straight to the output: memory and meshing time do not
 //! grow with the part, only the copying and writing do.
 //!
-//! Exactness. The template is sampled with index-periodic phases ([`TpmsField`]'s
-//! `samples_per_cell`), so sample values one cell apart are bit-identical, and OpenVDB meshes
+//! Exactness. The template is sampled with index-periodic phases (a [`Solid`]'s field is
+//! sampled by index modulo the cell), so sample values one cell apart are bit-identical, and OpenVDB meshes
 //! identical samples identically: cell kinds agree wherever they meet. Vertices are named by
 //! [`VertexKey`] (voxel and edge group); a quad belongs to the cell holding its edge's lower
 //! sample, a vertex to the cell holding its voxel. Each vertex of the big part is taken from one
@@ -21,16 +21,22 @@
 //! the *twin* of the template vertex — the same key one cell over, inside the interior cell.
 //!
 //! Requirements: adaptivity 0 (OpenVDB's adaptive merging is not local), a whole number of
-//! OpenVDB leaves (8 voxels) per cell along each copied axis, and cells of at least [`MIN_SAMPLES_PER_CELL`] voxels, so the
-//! box's influence (narrow band, clipping, snapping) dies out well inside the first cell.
+//! OpenVDB leaves (8 voxels) per cell along each copied axis, and cells of at least
+//! [`MIN_SAMPLES_PER_CELL`] voxels, so the box's influence (narrow band, clipping, snapping)
+//! dies out well inside the first cell.
 //!
-//! [`TpmsField`]: super::TpmsField
+//! Measuring. The part's volume is the template's, cell kind by cell kind, times how often each
+//! kind occurs, corrected for where the copies sit ([`Template::part_volume`]): the level that
+//! gives a part its density can be found on the template alone. Without the leaf alignment the
+//! copies would not be bit-exact, but a template still measures the part (a *measuring
+//! template*, [`measuring_plan`]); fragments the box cuts loose are found on the template too.
 
-use super::{Lattice, MeshingStats};
 use crate::error::{Error, Result};
 use crate::extract::{KeyedMesh, VertexKey};
 use crate::field::{Aabb, Vec3};
 use crate::grid::GridSpec;
+use crate::pieces::{Fragments, Shells};
+use crate::pipeline::{MeshingStats, Solid};
 use crate::sink::{Measures, MeshSink, Triangle};
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -79,6 +85,16 @@ impl AxisPlan {
 /// Plans instancing for a lattice box of `size` with cells of `cell`, sampled at voxel `h`;
 /// `None` when no axis can be copied.
 pub fn plan(size: Vec3, cell: Vec3, h: f64) -> Option<[AxisPlan; 3]> {
+    plan_with(size, cell, h, true)
+}
+
+/// Plans a measuring template: like [`plan`], but a cell need not span whole OpenVDB leaves
+/// (the copies' volumes agree with the part's to rounding, their vertices not bit for bit).
+pub fn measuring_plan(size: Vec3, cell: Vec3, h: f64) -> Option<[AxisPlan; 3]> {
+    plan_with(size, cell, h, false)
+}
+
+fn plan_with(size: Vec3, cell: Vec3, h: f64, leaf_aligned: bool) -> Option<[AxisPlan; 3]> {
     let axes = [0, 1, 2].map(|a| {
         let n = ((size[a] / cell[a]) * (1.0 - 1e-12)).ceil().max(1.0) as i64;
         let last = size[a] - (n - 1) as f64 * cell[a];
@@ -88,7 +104,7 @@ pub fn plan(size: Vec3, cell: Vec3, h: f64) -> Option<[AxisPlan; 3]> {
         let m = if partial { 4 } else { 3 };
         // OpenVDB meshes leaf by leaf (8³ voxels) and settles ambiguous voxels at leaf borders
         // its own way: a cell meshes alike wherever it is only if it spans whole leaves.
-        let aligned = p as i64 % BLOCK as i64 == 0;
+        let aligned = !leaf_aligned || p as i64 % BLOCK as i64 == 0;
         if whole && aligned && p as i64 >= MIN_SAMPLES_PER_CELL && n > m {
             AxisPlan { n, m, p: p as i64 }
         } else {
@@ -123,23 +139,68 @@ pub struct Template {
     /// Per vertex and axis: the vertex with the same key shifted along that axis into template
     /// cell 1, or `u32::MAX`.
     twin: Vec<[u32; 3]>,
+    /// Fragments removed from the template, per template cell (by the cell of each fragment's
+    /// least vertex key): how many, and their volume.
+    fragments_by_cell: Vec<(u64, f64)>,
+    /// Keys of the vertices of removed fragments.
+    fragment_keys: std::collections::HashSet<VertexKey>,
 }
 
 impl Template {
-    /// Meshes the template of `lattice` (the part) on voxels of size `h`.
-    pub fn build(
-        lattice: &Lattice,
+    /// Meshes the template of `solid` (the part, periodic with cells starting at its box's
+    /// lower corner) on voxels of size `h`; removes the fragments the box cuts loose unless
+    /// `keep_fragments`.
+    pub fn build<S: Solid>(
+        solid: &S,
         h: f64,
         plan: [AxisPlan; 3],
+        keep_fragments: bool,
     ) -> Result<(Template, MeshingStats)> {
-        let tb = template_bounds(&lattice.bounds, lattice.cell, &plan);
-        let small = Lattice {
-            bounds: tb,
-            ..*lattice
-        };
-        let spec = GridSpec::covering(&tb, h, super::HALF_WIDTH);
-        let (mesh, stats) = small.mesh_keyed(spec, 0.0)?;
-        Ok((Template::from_mesh(mesh, lattice.cell, plan)?, stats))
+        let cell = solid
+            .period()
+            .ok_or_else(|| Error::invalid("a template needs a periodic solid"))?;
+        let tb = template_bounds(&solid.bounds(), cell, &plan);
+        let small = solid.with_bounds(tb);
+        let spec = GridSpec::covering(&tb, h, crate::pipeline::HALF_WIDTH);
+        let (mut mesh, stats) = crate::pipeline::mesh_keyed(&small, spec, None, 0.0, None)?;
+        let m = plan.map(|a| a.m as usize);
+        let mut fragments_by_cell = vec![(0u64, 0.0f64); m[0] * m[1] * m[2]];
+        let mut fragment_keys = std::collections::HashSet::new();
+        if !keep_fragments {
+            let shells = Shells::of(&mesh);
+            if shells.kept.iter().any(|&k| !k) {
+                // Each removed shell is counted in the cell of its least vertex key, so that
+                // every copy of it in the part is counted once.
+                let mut least = vec![None::<VertexKey>; shells.volume.len()];
+                for (v, k) in mesh.keys.iter().enumerate() {
+                    let s = shells.of_vertex[v] as usize;
+                    if !shells.kept[s] {
+                        fragment_keys.insert(*k);
+                        if least[s].is_none_or(|l| *k < l) {
+                            least[s] = Some(*k);
+                        }
+                    }
+                }
+                for (s, key) in least.iter().enumerate() {
+                    if let Some(key) = key {
+                        let c = [0, 1, 2].map(|a| plan[a].cell_of(key.voxel[a] as i64) as usize);
+                        let e = &mut fragments_by_cell[(c[0] * m[1] + c[1]) * m[2] + c[2]];
+                        e.0 += (shells.volume[s] > 0.0) as u64;
+                        e.1 += shells.volume[s];
+                    }
+                }
+                let keep: Vec<bool> = shells
+                    .of_vertex
+                    .iter()
+                    .map(|&s| shells.kept[s as usize])
+                    .collect();
+                crate::pieces::retain(&mut mesh, &keep);
+            }
+        }
+        let mut t = Template::from_mesh(mesh, cell, plan)?;
+        t.fragments_by_cell = fragments_by_cell;
+        t.fragment_keys = fragment_keys;
+        Ok((t, stats))
     }
 
     fn from_mesh(mesh: KeyedMesh, cell: Vec3, plan: [AxisPlan; 3]) -> Result<Template> {
@@ -185,6 +246,8 @@ impl Template {
             point_cell,
             quads_by_cell,
             twin,
+            fragments_by_cell: Vec::new(),
+            fragment_keys: Default::default(),
         })
     }
 
@@ -229,26 +292,113 @@ impl Template {
 
     /// Σ over the part's cells of `f(kind)`, counting cells per kind instead of visiting them.
     fn count_over_cells(&self, f: impl Fn(usize) -> u64) -> u64 {
-        let per_axis = self.plan.map(|ax| {
-            let mut counts = vec![0u64; ax.m as usize];
-            for t in 0..ax.m {
-                counts[t as usize] = if ax.m == ax.n || t != 1 {
-                    1
-                } else {
-                    (ax.n - ax.m + 1) as u64
-                };
-            }
-            counts
-        });
         let mut total = 0;
-        for (i, &cx) in per_axis[0].iter().enumerate() {
-            for (j, &cy) in per_axis[1].iter().enumerate() {
-                for (k, &cz) in per_axis[2].iter().enumerate() {
-                    total += cx * cy * cz * f(self.kind_index([i as i64, j as i64, k as i64]));
+        self.for_each_kind(|k, count, _| total += count * f(k));
+        total
+    }
+
+    /// Calls `f(kind, cells, shift)` for every template cell: how many cells of the part are of
+    /// its kind, and the sum over them of their offset from the template cell, mm.
+    fn for_each_kind(&self, mut f: impl FnMut(usize, u64, Vec3)) {
+        // Per axis and template cell: (cells of the part, Σ of their offsets in cells).
+        let per_axis = self.plan.map(|ax| {
+            (0..ax.m)
+                .map(|t| {
+                    let extra = ax.n - ax.m;
+                    if ax.m == ax.n || t == 0 {
+                        (1u64, 0.0)
+                    } else if t == 1 {
+                        ((extra + 1) as u64, (extra * (extra + 1)) as f64 / 2.0)
+                    } else {
+                        (1, extra as f64)
+                    }
+                })
+                .collect::<Vec<_>>()
+        });
+        for (i, &(cx, sx)) in per_axis[0].iter().enumerate() {
+            for (j, &(cy, sy)) in per_axis[1].iter().enumerate() {
+                for (k, &(cz, sz)) in per_axis[2].iter().enumerate() {
+                    let shift = [
+                        sx * (cy * cz) as f64 * self.cell[0],
+                        sy * (cx * cz) as f64 * self.cell[1],
+                        sz * (cx * cy) as f64 * self.cell[2],
+                    ];
+                    f(
+                        self.kind_index([i as i64, j as i64, k as i64]),
+                        cx * cy * cz,
+                        shift,
+                    );
                 }
             }
         }
+    }
+
+    /// Enclosed volume of the whole part, mm³, without writing it: each triangle of a template
+    /// cell stands for one in every cell of its kind, and a triangle moved by `d` adds
+    /// `d · n / 3` to the divergence-theorem volume (`n` its area vector), so per kind the sum of
+    /// the triangles' volumes and of their area vectors is enough.
+    pub fn part_volume(&self) -> f64 {
+        use crate::mesh::{cross, dot, sub};
+        let pos = |v: u32| self.mesh.positions[v as usize].map(|x| x as f32 as f64);
+        let per_kind: Vec<(f64, Vec3)> = self
+            .quads_by_cell
+            .par_iter()
+            .map(|qs| {
+                let (mut vol, mut area) = (0.0, [0.0; 3]);
+                for &q in qs {
+                    let (t, u) = self.mesh.quad_triangles(q as usize);
+                    for tri in std::iter::once(t).chain(u) {
+                        let [a, b, c] = tri.map(pos);
+                        vol += dot(a, cross(b, c)) / 6.0;
+                        let n = cross(sub(b, a), sub(c, a));
+                        for x in 0..3 {
+                            area[x] += 0.5 * n[x];
+                        }
+                    }
+                }
+                (vol, area)
+            })
+            .collect();
+        let mut total = 0.0;
+        self.for_each_kind(|k, count, shift| {
+            total += count as f64 * per_kind[k].0 + dot(shift, per_kind[k].1) / 3.0;
+        });
         total
+    }
+
+    /// The fragments the box cuts loose in the whole part (removed from the template, so from
+    /// every copy).
+    pub fn part_fragments(&self) -> Fragments {
+        let mut f = Fragments {
+            removed: true,
+            ..Default::default()
+        };
+        if self.fragments_by_cell.is_empty() {
+            f.removed = false;
+            return f;
+        }
+        self.for_each_kind(|k, count, _| {
+            f.count += count * self.fragments_by_cell[k].0;
+            f.volume += count as f64 * self.fragments_by_cell[k].1;
+        });
+        f
+    }
+
+    /// Whether the vertex of the part with key `key` is a copy of a removed fragment's vertex.
+    pub fn is_fragment(&self, key: &VertexKey) -> bool {
+        if self.fragment_keys.is_empty() {
+            return false;
+        }
+        let mut k = *key;
+        for a in 0..3 {
+            let ax = self.plan[a];
+            if ax.n > ax.m {
+                let v = key.voxel[a] as i64;
+                let c = v.div_euclid(ax.p).clamp(0, ax.n - 1);
+                k.voxel[a] = (v - (c - ax.kind(c)) * ax.p) as i32;
+            }
+        }
+        self.fragment_keys.contains(&k)
     }
 
     /// Writes the whole part to `sink`, a batch of cells at a time, and measures what it wrote.

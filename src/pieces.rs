@@ -1,0 +1,181 @@
+//! Pieces: the separate solids a mesh encloses, and the removal of loose fragments.
+//!
+//! A box cuts a lattice where it likes, and near its faces it can cut a piece of the lattice
+//! loose: a fragment that is not joined to the part. It falls out of a powder bed or floats in
+//! a resin vat, so a part is written as one piece: the shells of the mesh (triangles joined
+//! through shared vertices) are grouped into pieces — a shell enclosing positive volume is the
+//! outside of a piece, one enclosing negative volume a cavity inside some piece — the piece of
+//! the largest volume is the part, and every other outer shell, with the cavities lying within
+//! its bounds, is a fragment.
+
+use crate::extract::KeyedMesh;
+use crate::field::Aabb;
+use crate::mesh::{cross, dot};
+use crate::topology::UnionFind;
+
+/// Fragments found (and removed, unless kept) in a mesh.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct Fragments {
+    /// Fragments: pieces not joined to the largest one.
+    pub count: u64,
+    /// Their volume, mm³.
+    pub volume: f64,
+    /// Whether they were removed from what was written.
+    pub removed: bool,
+}
+
+impl Fragments {
+    /// Adds another mesh's fragments (tiles or cells of one part).
+    pub fn add(&mut self, o: &Fragments) {
+        self.count += o.count;
+        self.volume += o.volume;
+        self.removed |= o.removed;
+    }
+}
+
+/// The shells of a keyed mesh and the pieces they form.
+pub struct Shells {
+    /// Shell of each vertex (dense ids, `0..count`).
+    pub of_vertex: Vec<u32>,
+    /// Per shell: signed enclosed volume (positive for an outer shell), mm³.
+    pub volume: Vec<f64>,
+    /// Per shell: bounds of its vertices.
+    pub bounds: Vec<Aabb>,
+    /// Per shell: whether it belongs to the largest piece.
+    pub kept: Vec<bool>,
+}
+
+impl Shells {
+    /// Finds the shells of `mesh` and which belong to its largest piece.
+    pub fn of(mesh: &KeyedMesh) -> Shells {
+        let n = mesh.positions.len();
+        let mut uf = UnionFind::new(n);
+        for q in &mesh.quads {
+            uf.union(q[0], q[1]);
+            uf.union(q[0], q[2]);
+            uf.union(q[0], q[3]);
+        }
+        let mut id = vec![u32::MAX; n];
+        let mut count = 0u32;
+        let of_vertex: Vec<u32> = (0..n as u32)
+            .map(|v| {
+                let r = uf.find(v) as usize;
+                if id[r] == u32::MAX {
+                    id[r] = count;
+                    count += 1;
+                }
+                id[r]
+            })
+            .collect();
+        let empty = Aabb {
+            min: [f64::INFINITY; 3],
+            max: [f64::NEG_INFINITY; 3],
+        };
+        let mut volume = vec![0.0; count as usize];
+        let mut bounds = vec![empty; count as usize];
+        for t in mesh.triangles() {
+            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+            volume[of_vertex[t[0] as usize] as usize] += dot(a, cross(b, c)) / 6.0;
+        }
+        for (v, p) in mesh.positions.iter().enumerate() {
+            let b = &mut bounds[of_vertex[v] as usize];
+            for a in 0..3 {
+                b.min[a] = b.min[a].min(p[a]);
+                b.max[a] = b.max[a].max(p[a]);
+            }
+        }
+        let main = (0..count as usize).max_by(|&a, &b| volume[a].total_cmp(&volume[b]));
+        let inside = |inner: &Aabb, outer: &Aabb| {
+            (0..3).all(|a| inner.min[a] >= outer.min[a] && inner.max[a] <= outer.max[a])
+        };
+        // An outer shell other than the main one is a fragment; a cavity goes with the
+        // fragment whose bounds hold it, and otherwise with the part.
+        let kept: Vec<bool> = (0..count as usize)
+            .map(|s| match main {
+                Some(m) if s == m => true,
+                _ if volume[s] > 0.0 => false,
+                _ => !(0..count as usize)
+                    .any(|o| Some(o) != main && volume[o] > 0.0 && inside(&bounds[s], &bounds[o])),
+            })
+            .collect();
+        Shells {
+            of_vertex,
+            volume,
+            bounds,
+            kept,
+        }
+    }
+
+    /// The fragments: outer shells not kept, with the cavities they hold.
+    pub fn fragments(&self, removed: bool) -> Fragments {
+        let mut f = Fragments {
+            removed,
+            ..Default::default()
+        };
+        for (s, &k) in self.kept.iter().enumerate() {
+            if !k {
+                f.count += (self.volume[s] > 0.0) as u64;
+                f.volume += self.volume[s];
+            }
+        }
+        f
+    }
+}
+
+/// Removes the fragments of `mesh` (every shell not in its largest piece), keeping the order of
+/// the vertices and quads that stay; returns what was removed.
+pub fn remove_fragments(mesh: &mut KeyedMesh) -> Fragments {
+    let shells = Shells::of(mesh);
+    let f = shells.fragments(true);
+    if f.count == 0 && shells.kept.iter().all(|&k| k) {
+        return f;
+    }
+    let keep_vertex: Vec<bool> = shells
+        .of_vertex
+        .iter()
+        .map(|&s| shells.kept[s as usize])
+        .collect();
+    retain(mesh, &keep_vertex);
+    f
+}
+
+/// Keeps the vertices marked in `keep` and the quads whose corners are all kept, renumbering.
+pub fn retain(mesh: &mut KeyedMesh, keep: &[bool]) {
+    let mut new_index = vec![u32::MAX; keep.len()];
+    let mut next = 0u32;
+    for (v, &k) in keep.iter().enumerate() {
+        if k {
+            new_index[v] = next;
+            next += 1;
+        }
+    }
+    let mut w = 0;
+    for v in 0..keep.len() {
+        if keep[v] {
+            mesh.keys[w] = mesh.keys[v];
+            mesh.positions[w] = mesh.positions[v];
+            mesh.offsets[w] = mesh.offsets[v];
+            w += 1;
+        }
+    }
+    mesh.keys.truncate(w);
+    mesh.positions.truncate(w);
+    mesh.offsets.truncate(w);
+    let mut w = 0;
+    for q in 0..mesh.quads.len() {
+        let quad = mesh.quads[q];
+        if quad.iter().all(|&v| keep[v as usize]) {
+            mesh.quads[w] = quad.map(|v| new_index[v as usize]);
+            if !mesh.edges.is_empty() {
+                mesh.edges[w] = mesh.edges[q];
+            }
+            mesh.diagonal_bd[w] = mesh.diagonal_bd[q];
+            w += 1;
+        }
+    }
+    mesh.quads.truncate(w);
+    if !mesh.edges.is_empty() {
+        mesh.edges.truncate(w);
+    }
+    mesh.diagonal_bd.truncate(w);
+}

@@ -1,0 +1,712 @@
+//! The pipeline: any solid clipped by its box → a verified mesh streamed to a sink, at the
+//! level that gives it its target volume fraction.
+//!
+//! A capability describes its geometry as a [`Family`] of [`Solid`]s indexed by a level (the TPMS
+//! level `t`, a strut radius, …) that thickens the solid as it grows. The pipeline then:
+//!
+//! 1. **routes** the part ([`Route`]): copied cell by cell from a meshed template when the solid
+//!    is periodic and the cells span whole OpenVDB leaves ([`crate::instance`]), meshed in tiles
+//!    when its grid would not fit the memory budget ([`crate::tile`]), or meshed whole;
+//! 2. **finds the level on the part itself** ([`solve`]): the part is meshed (or, for large
+//!    periodic parts, a template of its cells is — [`Template::part_volume`] gives the whole
+//!    part's volume from it), its loose fragments removed, its volume fraction measured, and
+//!    the level corrected until the fraction is within [`AIM`] of the target: a part that is
+//!    not a whole number of cells, or meshed on coarse voxels, gets the level that is right
+//!    for *it*, not for the periodic cell;
+//! 3. **writes** it: the whole mesh after CGAL's checks, the copies of the template (checked
+//!    by CGAL) or the tiles (each checked as it is written), dropping the fragments.
+//!
+//! When no level gives the target within [`PROMISE`] on these voxels (a lattice whose members
+//! are thinner than the voxels falls apart below some level and jumps in volume above it),
+//! [`solve`] says so with the closest fraction it found, and the caller raises the resolution
+//! or refuses.
+
+use crate::error::{Error, Result};
+use crate::extract::KeyedMesh;
+use crate::field::{Aabb, Field, Intersection, Vec3};
+use crate::grid::{Grid, GridSpec, IndexBox};
+use crate::instance::{self, AxisPlan, Template};
+use crate::mesh::Mesh;
+use crate::pieces::{self, Fragments};
+use crate::progress::Progress;
+use crate::sink::{Measures, MeshSink, Triangle};
+use crate::snap::SnapStats;
+use crate::tile;
+use crate::verify::{verify, verify_on, Verification};
+use std::time::Instant;
+
+/// Default narrow-band half width, voxels.
+pub const HALF_WIDTH: f64 = 3.0;
+
+/// The density a written part must have: within this of the target.
+pub const PROMISE: f64 = 0.002;
+
+/// The level is corrected until the part's measured fraction is within this of the target.
+pub const AIM: f64 = 0.001;
+
+/// Meshings of the part (or its template) the level search may take.
+pub const MAX_MESHINGS: u32 = 8;
+
+/// Memory a part may use while it is meshed when no budget is given: larger parts are meshed
+/// in tiles.
+pub const DEFAULT_MEMORY: u64 = 4 << 30;
+
+/// A solid clipped by its box: what the pipeline needs of a capability's geometry.
+pub trait Solid: Sync {
+    /// The solid's field, unclipped, set up for sampling on voxels of `spec` (a periodic solid
+    /// samples by index modulo its cell where a cell is a whole number of voxels, so that cells
+    /// mesh alike), its values clamped to the narrow band.
+    fn field(&self, spec: &GridSpec) -> Box<dyn Field + '_>;
+    /// The clipping box.
+    fn bounds(&self) -> Aabb;
+    /// The same solid clipped by another box (a template, a calibration cell).
+    fn with_bounds(&self, bounds: Aabb) -> Self
+    where
+        Self: Sized;
+    /// The cell size per axis, when the solid repeats with cells starting at its box's lower
+    /// corner.
+    fn period(&self) -> Option<Vec3>;
+}
+
+/// Solids indexed by a level; the solid grows with the level.
+pub trait Family: Sync {
+    type Solid: Solid;
+    /// The solid at `level`.
+    fn at(&self, level: f64) -> Self::Solid;
+    /// The volume fraction of the exact (unmeshed) solid at `level`, or a model of it that
+    /// increases with the level: the search steps the level through it.
+    fn model_fraction(&self, level: f64) -> f64;
+    /// The inverse of [`Family::model_fraction`].
+    fn model_level(&self, fraction: f64) -> f64;
+}
+
+/// Statistics of meshing.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct MeshingStats {
+    pub voxel_size: f64,
+    pub blocks_tested: u64,
+    pub blocks_sampled: u64,
+    pub active_voxels: u64,
+    pub grid_bytes: u64,
+    pub snap: SnapStats,
+    pub sample_seconds: f64,
+    pub mesh_seconds: f64,
+    pub snap_seconds: f64,
+}
+
+impl MeshingStats {
+    /// Adds another pass's counts and times (tiles of one part, meshings of a search).
+    pub fn add(&mut self, o: &MeshingStats) {
+        self.voxel_size = o.voxel_size;
+        self.blocks_tested += o.blocks_tested;
+        self.blocks_sampled += o.blocks_sampled;
+        self.active_voxels += o.active_voxels;
+        self.grid_bytes = self.grid_bytes.max(o.grid_bytes);
+        self.snap += o.snap;
+        self.sample_seconds += o.sample_seconds;
+        self.mesh_seconds += o.mesh_seconds;
+        self.snap_seconds += o.snap_seconds;
+    }
+}
+
+/// Samples `solid` on `spec` (on the blocks covering `region` only, for a tile), meshes it with
+/// OpenVDB and snaps the vertices onto the exact surface and box; with `snap_within`, only the
+/// vertices there are snapped (when only part of the mesh is measured).
+pub fn mesh_keyed<S: Solid + ?Sized>(
+    solid: &S,
+    spec: GridSpec,
+    region: Option<IndexBox>,
+    adaptivity: f64,
+    snap_within: Option<&Aabb>,
+) -> Result<(KeyedMesh, MeshingStats)> {
+    let field = solid.field(&spec);
+    let bounds = solid.bounds();
+    let clipped = Intersection {
+        a: &*field,
+        b: bounds,
+    };
+    let t = Instant::now();
+    let grid = match region {
+        Some(r) => Grid::sample_box(&clipped, spec, r)?,
+        None => Grid::sample(&clipped, spec)?,
+    };
+    let sample_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let mut keyed = if adaptivity == 0.0 {
+        KeyedMesh::extract(&grid)?
+    } else {
+        KeyedMesh::from_adaptive(&grid.to_mesh(adaptivity)?, &spec)
+    };
+    let mesh_seconds = t.elapsed().as_secs_f64();
+    let stats = MeshingStats {
+        voxel_size: spec.voxel,
+        blocks_tested: grid.blocks_tested,
+        blocks_sampled: grid.blocks_sampled,
+        active_voxels: grid.active_voxels(),
+        grid_bytes: grid.memory_bytes(),
+        sample_seconds,
+        mesh_seconds,
+        ..Default::default()
+    };
+    drop(grid);
+    let t = Instant::now();
+    let snap = crate::snap::snap_within(&mut keyed, &*field, &bounds, &spec, snap_within);
+    Ok((
+        keyed,
+        MeshingStats {
+            snap,
+            snap_seconds: t.elapsed().as_secs_f64(),
+            ..stats
+        },
+    ))
+}
+
+/// The grid a whole part is meshed on.
+pub fn part_spec<S: Solid + ?Sized>(solid: &S, voxel: f64) -> GridSpec {
+    GridSpec::covering(&solid.bounds(), voxel, HALF_WIDTH)
+}
+
+/// How the part is written, and what it is meshed with.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Options {
+    /// OpenVDB volumeToMesh adaptivity, 0 (uniform) to 1; above 0 the part is meshed whole.
+    pub adaptivity: f64,
+    /// Run the self-intersection test (the costliest check).
+    pub self_intersection: bool,
+    /// Copy a periodic part's cells from a meshed template where possible.
+    pub instancing: bool,
+    /// Mesh in tiles of this many samples a side (a multiple of 8), whatever the part's size.
+    pub tile: Option<i64>,
+    /// Memory budget, bytes ([`DEFAULT_MEMORY`] when not given).
+    pub memory: Option<u64>,
+    /// Keep the fragments the box cuts loose (they are removed by default).
+    pub keep_fragments: bool,
+}
+
+/// How a part is meshed and written.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Route {
+    /// Copied cell by cell from a meshed template.
+    Instanced([AxisPlan; 3]),
+    /// Meshed tile by tile, tiles of this many samples a side; the level is found on a
+    /// measuring template of its cells when there is one.
+    Tiled(i64, Option<[AxisPlan; 3]>),
+    /// Meshed at once; the level is found on a measuring template of its cells when there is
+    /// one, on the whole part otherwise.
+    Whole(Option<[AxisPlan; 3]>),
+}
+
+impl Route {
+    /// Chooses the route for `solid` on voxels of size `voxel`.
+    pub fn choose<S: Solid>(solid: &S, voxel: f64, o: &Options) -> Route {
+        let bounds = solid.bounds();
+        let plan = |f: fn(Vec3, Vec3, f64) -> Option<[AxisPlan; 3]>| {
+            solid.period().and_then(|c| f(bounds.size(), c, voxel))
+        };
+        if o.adaptivity != 0.0 {
+            return Route::Whole(None);
+        }
+        if o.instancing && o.tile.is_none() {
+            if let Some(p) = plan(instance::plan) {
+                return Route::Instanced(p);
+            }
+        }
+        let budget = o.memory.unwrap_or(DEFAULT_MEMORY);
+        let fits = |b: &Aabb| {
+            let spec = GridSpec::covering(b, voxel, HALF_WIDTH);
+            spec.padded_region().voxels() * tile::BYTES_PER_VOXEL <= budget
+        };
+        // A measuring template is worth meshing when it is small beside the part (each level
+        // tried meshes it, and the part is meshed once more at the level found) and when it
+        // fits in memory.
+        let measuring = plan(instance::measuring_plan).filter(|p| {
+            let (part, template): (i64, i64) = (
+                p.iter().map(|a| a.n).product(),
+                p.iter().map(|a| a.m).product(),
+            );
+            let cell = solid.period().expect("a plan needs a period");
+            part >= 4 * template && fits(&instance::template_bounds(&bounds, cell, p))
+        });
+        match o.tile {
+            Some(edge) => Route::Tiled(edge, measuring),
+            None if !fits(&bounds) => Route::Tiled(tile::tile_edge_for_budget(budget), measuring),
+            None => Route::Whole(measuring),
+        }
+    }
+}
+
+/// A part meshed at one level, ready to be written.
+pub enum Made {
+    /// The whole part's mesh (fragments removed unless kept).
+    Whole(KeyedMesh),
+    /// The part's template, to be copied.
+    Template(Template),
+    /// Nothing held: the part is meshed again, tile by tile, as it is written; the measuring
+    /// template (if any) says which vertices belong to fragments.
+    Tiles(Option<Template>),
+}
+
+/// A part meshed (or measured) at one level.
+pub struct Measured {
+    pub level: f64,
+    /// Volume fraction of what will be written.
+    pub fraction: f64,
+    pub made: Made,
+    pub fragments: Fragments,
+    pub meshing: MeshingStats,
+}
+
+/// Meshes or measures the solid at `level` on its route.
+pub fn measure<F: Family>(
+    family: &F,
+    level: f64,
+    voxel: f64,
+    route: Route,
+    o: &Options,
+) -> Result<Measured> {
+    let solid = family.at(level);
+    let box_volume = solid.bounds().volume();
+    let template = |plan| Template::build(&solid, voxel, plan, o.keep_fragments);
+    let (made, volume, fragments, meshing) = match route {
+        Route::Instanced(plan) | Route::Whole(Some(plan)) | Route::Tiled(_, Some(plan)) => {
+            let (t, stats) = template(plan)?;
+            let (v, f) = (t.part_volume(), t.part_fragments());
+            let made = match route {
+                Route::Instanced(_) => Made::Template(t),
+                Route::Tiled(..) => Made::Tiles(Some(t)),
+                // The whole part is meshed once the level is known.
+                Route::Whole(_) => Made::Tiles(Some(t)),
+            };
+            (made, v, f, stats)
+        }
+        Route::Whole(None) => {
+            let (mut mesh, stats) =
+                mesh_keyed(&solid, part_spec(&solid, voxel), None, o.adaptivity, None)?;
+            let f = if o.keep_fragments {
+                pieces::Shells::of(&mesh).fragments(false)
+            } else {
+                pieces::remove_fragments(&mut mesh)
+            };
+            let v = keyed_volume(&mesh);
+            (Made::Whole(mesh), v, f, stats)
+        }
+        Route::Tiled(edge, None) => {
+            // No template: the part's volume is measured tile by tile, nothing written.
+            let (v, stats) = tiled_volume(&solid, voxel, edge)?;
+            let f = Fragments::default();
+            (Made::Tiles(None), v, f, stats)
+        }
+    };
+    Ok(Measured {
+        level,
+        fraction: volume / box_volume,
+        made,
+        fragments,
+        meshing,
+    })
+}
+
+/// Enclosed volume of a keyed mesh as it is written (single-precision corners), mm³.
+pub fn keyed_volume(mesh: &KeyedMesh) -> f64 {
+    use crate::mesh::{cross, dot};
+    let tris: Vec<[u32; 3]> = mesh.triangles().collect();
+    crate::mesh::ordered_sum(tris.len(), |i| {
+        let [a, b, c] = tris[i].map(|v| mesh.positions[v as usize].map(|x| x as f32 as f64));
+        dot(a, cross(b, c)) / 6.0
+    })
+}
+
+/// The volume of the part meshed tile by tile, without writing it.
+fn tiled_volume<S: Solid>(solid: &S, voxel: f64, edge: i64) -> Result<(f64, MeshingStats)> {
+    let spec = part_spec(solid, voxel);
+    let stats = std::sync::Mutex::new(MeshingStats::default());
+    let mesh_tile = |r: IndexBox| {
+        let (m, s) = mesh_keyed(solid, spec, Some(r), 0.0, None)?;
+        stats
+            .lock()
+            .expect("no panic while holding the lock")
+            .add(&s);
+        Ok(m)
+    };
+    let mut sink = VolumeSink::default();
+    let out = tile::mesh_tiled(spec.padded_region(), edge, &mesh_tile, false, &mut sink)?;
+    Ok((
+        out.measures.volume,
+        stats.into_inner().expect("no panic while holding the lock"),
+    ))
+}
+
+/// A sink that keeps nothing (tiles are measured as they pass).
+#[derive(Default)]
+struct VolumeSink;
+
+impl MeshSink for VolumeSink {
+    fn begin(&mut self, _: Option<u64>) -> Result<()> {
+        Ok(())
+    }
+    fn triangles(&mut self, _: &[Triangle]) -> Result<()> {
+        Ok(())
+    }
+    fn finish(&mut self) -> Result<()> {
+        Ok(())
+    }
+}
+
+/// The level search's outcome.
+pub struct Solved {
+    /// The part at the level found (the closest one when the target was missed).
+    pub best: Measured,
+    /// Levels meshed and the fraction each gave, in order.
+    pub tried: Vec<(f64, f64)>,
+    /// Whether the fraction is within [`PROMISE`] of the target.
+    pub met: bool,
+    pub meshing: MeshingStats,
+}
+
+/// Finds the level at which the part's measured volume fraction is `target`, starting from
+/// `start`: each step reads the next level off the family's model at the target less the
+/// difference between measured and modelled fraction (the meshing's and the box's effect, which
+/// change slowly with the level); once the target is bracketed, regula falsi (Illinois) on the
+/// measured fractions. Stops within [`AIM`], or after [`MAX_MESHINGS`], or when the bracket
+/// closes on a jump (the solid falls apart on these voxels between two levels).
+pub fn solve<F: Family>(
+    family: &F,
+    target: f64,
+    start: f64,
+    voxel: f64,
+    route: Route,
+    o: &Options,
+) -> Result<Solved> {
+    let mut tried = Vec::new();
+    let mut meshing = MeshingStats::default();
+    let mut best: Option<Measured> = None;
+    // Bracket: (level, fraction − target as weighted by Illinois, fraction) below and above.
+    let mut lo: Option<(f64, f64, f64)> = None;
+    let mut hi: Option<(f64, f64, f64)> = None;
+    let mut side = 0i8;
+    let mut t = start;
+    for _ in 0..MAX_MESHINGS {
+        let m = measure(family, t, voxel, route, o)?;
+        meshing.add(&m.meshing);
+        let err = m.fraction - target;
+        tried.push((t, m.fraction));
+        if err < 0.0 {
+            if side == -1 {
+                if let Some(h) = hi.as_mut() {
+                    h.1 *= 0.5;
+                }
+            }
+            side = -1;
+            lo = Some((t, err, m.fraction));
+        } else {
+            if side == 1 {
+                if let Some(l) = lo.as_mut() {
+                    l.1 *= 0.5;
+                }
+            }
+            side = 1;
+            hi = Some((t, err, m.fraction));
+        }
+        if best
+            .as_ref()
+            .is_none_or(|b| err.abs() < (b.fraction - target).abs())
+        {
+            best = Some(m);
+        }
+        let best_err = best
+            .as_ref()
+            .map_or(f64::INFINITY, |b| (b.fraction - target).abs());
+        if best_err <= AIM {
+            break;
+        }
+        t = match (lo, hi) {
+            (Some((a, fa, pa)), Some((b, fb, pb))) => {
+                // How much the exact solid changes between the two levels, against how much
+                // the measured part does: far more means a jump (the part falls apart on these
+                // voxels below it), which regula falsi would creep up on; bisect instead, and
+                // stop once the jump is pinned or the closer side keeps the promise.
+                let gap = (family.model_fraction(b) - family.model_fraction(a)).abs();
+                let jump = (pb - pa).abs() > 4.0 * gap;
+                if gap < 1e-4 || (jump && best_err <= PROMISE) {
+                    break;
+                }
+                if jump {
+                    0.5 * (a + b)
+                } else {
+                    (a * fb - b * fa) / (fb - fa)
+                }
+            }
+            _ => {
+                let bias = (err + target) - family.model_fraction(t);
+                let next = family.model_level((target - bias).clamp(1e-6, 1.0 - 1e-6));
+                if next == t {
+                    // The model is flat here: step by the error in the model's own terms.
+                    t + err.signum() * -1e-3 * (1.0 + t.abs())
+                } else {
+                    next
+                }
+            }
+        };
+    }
+    let best = best.expect("at least one meshing");
+    let met = (best.fraction - target).abs() <= PROMISE;
+    Ok(Solved {
+        best,
+        tried,
+        met,
+        meshing,
+    })
+}
+
+/// Timings and checks of writing a part.
+pub struct Written {
+    pub checks: Verification,
+    pub meshing: MeshingStats,
+    pub measures: Measures,
+    pub vertices: u64,
+    pub fragments: Fragments,
+    pub instancing: Option<Instancing>,
+    pub tiling: Option<Tiling>,
+    pub verify_seconds: f64,
+    pub write_seconds: f64,
+}
+
+/// How the part was meshed when it was copied from a template (see [`crate::instance`]).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Instancing {
+    /// Cells of the part per axis that the template stands for (1 along axes not copied).
+    pub part_cells: [i64; 3],
+    /// Cells of the template per axis.
+    pub template_cells: [i64; 3],
+    pub template_triangles: u64,
+    /// CGAL's checks ran on the template, which holds every kind of cell the part has; the
+    /// part is written as exact copies of its cells.
+    pub verified: &'static str,
+}
+
+/// How the part was meshed when it was meshed in tiles (see [`crate::tile`]).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Tiling {
+    pub tiles: u64,
+    /// Tile edge, samples.
+    pub tile_samples: i64,
+    /// Samples meshed around each tile and not kept.
+    pub margin_samples: i64,
+    pub verified: &'static str,
+}
+
+/// Writes the part measured in `m` to `sink`, checking it on the way.
+pub fn write<F: Family>(
+    family: &F,
+    m: Measured,
+    voxel: f64,
+    route: Route,
+    o: &Options,
+    progress: &Progress,
+    sink: &mut dyn MeshSink,
+) -> Result<Written> {
+    let solid = family.at(m.level);
+    match (route, m.made) {
+        (Route::Instanced(plan), Made::Template(t)) => {
+            write_instanced(t, plan, m.meshing, m.fragments, o, progress, sink)
+        }
+        (Route::Whole(_), Made::Whole(mesh)) => {
+            write_whole(mesh.to_mesh(), m.meshing, m.fragments, o, progress, sink)
+        }
+        (Route::Whole(_), Made::Tiles(_)) => {
+            // Found on a measuring template: mesh the part at the level found.
+            let (mut mesh, meshing) = {
+                let _p = progress.stage("sampling and meshing");
+                mesh_keyed(&solid, part_spec(&solid, voxel), None, o.adaptivity, None)?
+            };
+            let fragments = if o.keep_fragments {
+                pieces::Shells::of(&mesh).fragments(false)
+            } else {
+                pieces::remove_fragments(&mut mesh)
+            };
+            write_whole(mesh.to_mesh(), meshing, fragments, o, progress, sink)
+        }
+        (Route::Tiled(edge, _), Made::Tiles(template)) => write_tiled(
+            &solid,
+            voxel,
+            edge,
+            template.as_ref(),
+            m.fragments,
+            o,
+            progress,
+            sink,
+        ),
+        _ => Err(Error::invalid("a part was measured on another route")),
+    }
+}
+
+fn write_instanced(
+    template: Template,
+    plan: [AxisPlan; 3],
+    meshing: MeshingStats,
+    fragments: Fragments,
+    o: &Options,
+    progress: &Progress,
+    sink: &mut dyn MeshSink,
+) -> Result<Written> {
+    // CGAL checks the template while the part is written: the two share the cores.
+    let template_mesh = template.mesh.to_mesh();
+    let (checks, verify_seconds, measures, write_seconds) = {
+        let _p = progress.stage("writing the part and verifying its template");
+        std::thread::scope(|scope| {
+            let checker = scope.spawn(|| {
+                let t = Instant::now();
+                let r = verify_on(&template_mesh, o.self_intersection, false);
+                (r, t.elapsed().as_secs_f64())
+            });
+            let t = Instant::now();
+            let measures = template.expand(sink);
+            let write_seconds = t.elapsed().as_secs_f64();
+            let (checks, verify_seconds) = checker.join().expect("the CGAL check does not panic");
+            (checks, verify_seconds, measures, write_seconds)
+        })
+    };
+    Ok(Written {
+        checks: checks?,
+        meshing,
+        measures: measures?,
+        vertices: template.vertex_count(),
+        fragments,
+        instancing: Some(Instancing {
+            part_cells: plan.map(|a| a.n),
+            template_cells: plan.map(|a| a.m),
+            template_triangles: template.mesh.triangle_count() as u64,
+            verified: "template",
+        }),
+        tiling: None,
+        verify_seconds,
+        write_seconds,
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn write_tiled<S: Solid>(
+    solid: &S,
+    voxel: f64,
+    edge: i64,
+    template: Option<&Template>,
+    fragments: Fragments,
+    o: &Options,
+    progress: &Progress,
+    sink: &mut dyn MeshSink,
+) -> Result<Written> {
+    let spec = part_spec(solid, voxel);
+    let stats = std::sync::Mutex::new(MeshingStats::default());
+    let mesh_tile = |r: IndexBox| {
+        let (mut m, s) = mesh_keyed(solid, spec, Some(r), 0.0, None)?;
+        stats
+            .lock()
+            .expect("no panic while holding the lock")
+            .add(&s);
+        if let Some(t) = template.filter(|_| !o.keep_fragments) {
+            let keep: Vec<bool> = m.keys.iter().map(|k| !t.is_fragment(k)).collect();
+            if keep.iter().any(|&k| !k) {
+                pieces::retain(&mut m, &keep);
+            }
+        }
+        Ok(m)
+    };
+    let t = Instant::now();
+    let out = {
+        let _p = progress.stage("meshing and writing the part tile by tile");
+        tile::mesh_tiled(
+            spec.padded_region(),
+            edge,
+            &mesh_tile,
+            o.self_intersection,
+            sink,
+        )?
+    };
+    let closed = out.bad_edges == 0;
+    let m = out.measures;
+    Ok(Written {
+        checks: Verification {
+            manifold: closed,
+            closed,
+            outward: closed && m.volume > 0.0,
+            self_intersection_checked: out.self_intersection_checked,
+            self_intersecting: out.self_intersecting,
+            volume: closed.then_some(m.volume),
+            area: m.area,
+            faces: m.triangles,
+            vertices: out.vertices,
+            border_edges: out.bad_edges,
+            components: 0,
+        },
+        meshing: stats.into_inner().expect("no panic while holding the lock"),
+        measures: m,
+        vertices: out.vertices,
+        fragments,
+        instancing: None,
+        tiling: Some(Tiling {
+            tiles: out.tiles,
+            tile_samples: edge,
+            margin_samples: tile::MARGIN,
+            verified: "per tile: edges counted by latvox, self-intersection by CGAL",
+        }),
+        verify_seconds: 0.0,
+        write_seconds: t.elapsed().as_secs_f64(),
+    })
+}
+
+fn write_whole(
+    mesh: Mesh,
+    meshing: MeshingStats,
+    fragments: Fragments,
+    o: &Options,
+    progress: &Progress,
+    sink: &mut dyn MeshSink,
+) -> Result<Written> {
+    let t = Instant::now();
+    let checks = {
+        let _p = progress.stage("verifying with CGAL");
+        verify(&mesh, o.self_intersection)?
+    };
+    let verify_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let measures = {
+        let _p = progress.stage("writing the part");
+        write_mesh(&mesh, sink)?
+    };
+    Ok(Written {
+        checks,
+        meshing,
+        measures,
+        vertices: mesh.vertex_count() as u64,
+        fragments,
+        instancing: None,
+        tiling: None,
+        verify_seconds,
+        write_seconds: t.elapsed().as_secs_f64(),
+    })
+}
+
+/// Streams an in-memory mesh into `sink` in batches, measuring it on the way.
+pub fn write_mesh(mesh: &Mesh, sink: &mut dyn MeshSink) -> Result<Measures> {
+    use rayon::prelude::*;
+    sink.begin(Some(mesh.triangle_count() as u64))?;
+    let mut measures = Measures::default();
+    const BATCH: usize = 1 << 16;
+    for start in (0..mesh.triangle_count()).step_by(BATCH) {
+        let end = (start + BATCH).min(mesh.triangle_count());
+        let tris: Vec<Triangle> = (start..end)
+            .into_par_iter()
+            .map(|t| {
+                let i = &mesh.indices[3 * t..3 * t + 3];
+                [i[0], i[1], i[2]].map(|v| {
+                    let p = &mesh.positions[3 * v as usize..3 * v as usize + 3];
+                    [p[0], p[1], p[2]]
+                })
+            })
+            .collect();
+        measures = measures.merged(&Measures::of(&tris));
+        sink.triangles(&tris)?;
+    }
+    sink.finish()?;
+    Ok(measures)
+}
