@@ -111,7 +111,7 @@ pub struct Loaded {
 }
 
 /// Parses `data` as `format`.
-pub fn parse(data: &[u8], format: Format) -> std::result::Result<Parsed, String> {
+pub fn parse(data: &[u8], format: Format) -> Result<Parsed> {
     match format {
         Format::Stl => stl::parse_facets(data),
         Format::Obj => obj::parse(data),
@@ -130,10 +130,8 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded> {
     }
     let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let format = Format::from_path(path).unwrap_or_else(|| Format::sniff(&data));
-    let p = parse(&data, format).map_err(|message| Error::Format {
-        path: path.to_path_buf(),
-        message: format!("{}: {message}", format.name()),
-    })?;
+    let p = parse(&data, format)
+        .map_err(|e| Error::parse(format!("{}: {e}", format.name())).in_file(path))?;
     drop(data);
     let mut mesh = p.mesh;
     let tolerance_welded = weld::weld_tolerance(&mut mesh, opts.weld_tolerance);
@@ -206,15 +204,15 @@ impl PolygonSink {
         self.positions.len() / 3
     }
 
-    pub fn push_vertex(&mut self, p: [f32; 3]) -> std::result::Result<(), String> {
+    pub fn push_vertex(&mut self, p: [f32; 3]) -> Result<()> {
         if !p.iter().all(|v| v.is_finite()) {
-            return Err(format!(
+            return Err(Error::parse(format!(
                 "vertex {}: non-finite coordinate {p:?}",
                 self.vertex_count() + 1
-            ));
+            )));
         }
         if self.vertex_count() >= u32::MAX as usize {
-            return Err("more than 2^32 vertices".into());
+            return Err(Error::parse("more than 2^32 vertices"));
         }
         self.positions.extend_from_slice(&p);
         Ok(())
@@ -226,10 +224,12 @@ impl PolygonSink {
     }
 
     /// Closes the current face; its indices must name vertices already read.
-    pub fn end_face(&mut self) -> std::result::Result<(), String> {
+    pub fn end_face(&mut self) -> Result<()> {
         let nv = self.vertex_count();
         if let Some(&bad) = self.corners.iter().find(|&&i| i as usize >= nv) {
-            return Err(format!("face corner {bad} past the {nv} vertices"));
+            return Err(Error::parse(format!(
+                "face corner {bad} past the {nv} vertices"
+            )));
         }
         let c = std::mem::take(&mut self.corners);
         match c.len() {
@@ -264,9 +264,9 @@ impl PolygonSink {
         Ok(())
     }
 
-    pub fn finish(self) -> std::result::Result<Parsed, String> {
+    pub fn finish(self) -> Result<Parsed> {
         if self.indices.is_empty() {
-            return Err("no triangles in the file".into());
+            return Err(Error::parse("no triangles in the file"));
         }
         Ok(Parsed {
             mesh: weld::weld_indexed(&self.positions, &self.indices)?,
