@@ -97,7 +97,7 @@ impl Task for TpmsArgs {
     fn run(&self) -> Result<TaskReport> {
         let r = super::tpms::execute(self, &Progress::hidden())?;
         Ok(TaskReport {
-            passed: super::tpms::passed(&r),
+            passed: r.checks.verdict().is_valid_solid(),
             warnings: r.warnings.clone(),
             report: serde_json::to_value(&r).map_err(|e| Error::invalid(e.to_string()))?,
         })
@@ -272,13 +272,13 @@ pub fn run(a: &BatchArgs, quiet: bool) -> Result<i32> {
                     "  {:<8}{:>8.2} s  #{:<5} {}",
                     r.status.name(),
                     r.seconds,
-                    r.job,
-                    r.output
+                    r.name.job,
+                    r.name.output
                 );
                 if let Some(e) = &r.error {
                     line.push_str(&format!(": {e}"));
                 } else if r.status == Status::Defects {
-                    line.push_str(&format!(": checks found defects (see {})", r.report));
+                    line.push_str(&format!(": checks found defects (see {})", r.name.report));
                 }
                 c.println(&line);
             }
@@ -324,38 +324,23 @@ pub fn run(a: &BatchArgs, quiet: bool) -> Result<i32> {
 }
 
 fn dry_run(file: &JobFile, tasks: &[&dyn Task], settings: Settings, json: bool) -> Result<i32> {
-    let mut rows = Vec::new();
-    for (job, task) in file.jobs.iter().zip(tasks) {
-        if !settings.shard.is_none_or(|s| s.contains(job.index)) {
-            continue;
-        }
-        let done = !settings.force && batch::previous_run(file, job, *task).is_some();
-        rows.push(serde_json::json!({
-            "job": job.index + 1,
-            "origin": job.origin,
-            "command": job.command,
-            "output": job.output,
-            "report": job.report,
-            "hash": job.hash,
-            "done": done,
-            "options": job.options_json(),
-        }));
-        if !json {
-            println!(
-                "#{:<5} {:<9} {} {}  ({})",
-                job.index + 1,
-                if done { "done" } else { "to run" },
-                job.command,
-                job.output,
-                job.origin
-            );
-        }
-    }
+    let jobs = batch::plan(file, tasks, settings);
     if json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&rows).map_err(|e| Error::invalid(e.to_string()))?
+            serde_json::to_string_pretty(&jobs).map_err(|e| Error::invalid(e.to_string()))?
         );
+    } else {
+        for j in &jobs {
+            println!(
+                "#{:<5} {:<9} {} {}  ({})",
+                j.name.job,
+                if j.done { "done" } else { "to run" },
+                j.name.command,
+                j.name.output,
+                j.name.origin
+            );
+        }
     }
     Ok(0)
 }

@@ -132,7 +132,7 @@ pub(crate) fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<
 pub(crate) fn emit_json(
     report: Option<&Path>,
     json: bool,
-    value: &serde_json::Value,
+    value: &impl serde::Serialize,
 ) -> Result<bool> {
     if let Some(r) = report {
         write_json(r, value)?;
@@ -144,6 +144,23 @@ pub(crate) fn emit_json(
         );
     }
     Ok(json)
+}
+
+/// CGAL's findings, as the summaries print them.
+pub(crate) fn cgal_findings(c: &latvox::verify::Verification) -> String {
+    format!(
+        "closed {}  outward {}  manifold {}  self-intersections {}",
+        yes(c.closed),
+        yes(c.outward),
+        yes(c.manifold),
+        if !c.self_intersection_checked {
+            "not checked"
+        } else if c.self_intersecting {
+            "FOUND"
+        } else {
+            "none"
+        }
+    )
 }
 
 pub(crate) fn yes(b: bool) -> &'static str {

@@ -1,6 +1,6 @@
 //! `latvox topo`: a density field to a printable STL and parametric CAD (seed 003).
 
-use super::{write_json, yes};
+use super::{cgal_findings, write_json};
 use clap::Args;
 use latvox::io::stl::StlFormat;
 use latvox::topo::job::{self, TopoJob};
@@ -255,11 +255,12 @@ pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
             100.0 * r.report.measure_change
         );
     }
-    let valid = r.report.checks.closed
-        && r.report.checks.outward
-        && r.report.checks.manifold
-        && !r.report.checks.self_intersecting;
-    Ok(if r.report.clean && valid { 0 } else { 1 })
+    // Features the printer cannot make that remain after the last pass are defects too.
+    Ok(if r.report.clean {
+        r.report.checks.verdict().exit_code()
+    } else {
+        1
+    })
 }
 
 fn timestamp() -> String {
@@ -316,20 +317,10 @@ fn summary(r: &job::TopoReport, a: &TopoArgs, images: &[PathBuf]) {
         r.final_measure,
         100.0 * r.measure_change
     );
-    let c = &r.checks;
     println!(
-        "mesh      {} triangles; CGAL closed {}  outward {}  manifold {}  self-intersections {}",
+        "mesh      {} triangles; CGAL {}",
         r.triangles,
-        yes(c.closed),
-        yes(c.outward),
-        yes(c.manifold),
-        if !c.self_intersection_checked {
-            "not checked"
-        } else if c.self_intersecting {
-            "FOUND"
-        } else {
-            "none"
-        }
+        cgal_findings(&r.checks)
     );
     if !r.loops.is_empty() {
         println!(

@@ -1,8 +1,8 @@
 //! `latvox tpms`: a closed TPMS lattice at an exact volume fraction.
 
 use super::{
-    parse_counts, parse_density, parse_finite3, parse_positive3, parse_size, parse_tile,
-    parse_unit, write_json, yes,
+    cgal_findings, parse_counts, parse_density, parse_finite3, parse_positive3, parse_size,
+    parse_tile, parse_unit, write_json,
 };
 use clap::Args;
 use latvox::io::stl::StlFormat;
@@ -147,7 +147,7 @@ pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
         eprintln!("latvox: warning: {w}");
     }
     print_tpms_summary(&report);
-    Ok(if passed(&report) { 0 } else { 1 })
+    Ok(report.checks.verdict().exit_code())
 }
 
 /// Runs the job and writes its mesh atomically; returns the report (output and write time
@@ -181,14 +181,7 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
     Ok(report)
 }
 
-/// Whether the part passed CGAL's checks (those that were asked for).
-pub fn passed(r: &TpmsReport) -> bool {
-    r.checks.is_valid_solid()
-        || !r.checks.self_intersection_checked && r.checks.closed && r.checks.outward
-}
-
 fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
-    let c = &r.checks;
     println!(
         "{} {} · {}×{}×{} cells of {}×{}×{} mm · {} voxels/cell ({:.4} mm)",
         r.surface.name(),
@@ -219,19 +212,7 @@ fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
             b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]
         );
     }
-    println!(
-        "CGAL      closed {}  outward {}  manifold {}  self-intersections {}",
-        yes(c.closed),
-        yes(c.outward),
-        yes(c.manifold),
-        if !c.self_intersection_checked {
-            "not checked"
-        } else if c.self_intersecting {
-            "FOUND"
-        } else {
-            "none"
-        }
-    );
+    println!("CGAL      {}", cgal_findings(&r.checks));
     let t = &r.timings;
     println!(
         "time      {:.3} s (calibrate {:.3}, sample {:.3}, mesh {:.3}, snap {:.3}, verify {:.3}, write {:.3})",

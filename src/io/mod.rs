@@ -110,6 +110,25 @@ pub struct Loaded {
     pub tolerance_welded: u64,
 }
 
+impl Loaded {
+    /// What reading did to the file.
+    pub fn reading(&self) -> Reading {
+        Reading {
+            faces_with_fewer_than_3_corners_skipped: self.short_faces,
+            polygons_split_into_triangles: self.polygons_split,
+            vertices_merged_by_tolerance: self.tolerance_welded,
+        }
+    }
+}
+
+/// What reading a file did to it, as reports give it (all zero for a clean file).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Reading {
+    pub faces_with_fewer_than_3_corners_skipped: u64,
+    pub polygons_split_into_triangles: u64,
+    pub vertices_merged_by_tolerance: u64,
+}
+
 /// Parses `data` as `format`.
 pub fn parse(data: &[u8], format: Format) -> Result<Parsed> {
     match format {

@@ -258,7 +258,7 @@ impl TpmsJob {
         } = written;
         let volume = measures.volume;
         let achieved = volume / bounds.volume();
-        if !checks.is_valid_solid() && (checks.self_intersection_checked || !checks.closed) {
+        if !checks.verdict().is_valid_solid() {
             warnings.push(
                 "CGAL did not find the mesh a valid closed, outward, self-intersection-free solid"
                     .into(),
