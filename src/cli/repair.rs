@@ -4,6 +4,7 @@
 use super::check::{print_header, print_summary};
 use clap::Args;
 use latvox::repair::{repair_file, RepairOptions};
+use latvox::sink::MeshFile;
 use latvox::Result;
 use std::path::PathBuf;
 
@@ -58,12 +59,7 @@ pub struct RepairArgs {
 
 pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
     latvox::output::check_writable(&a.output)?;
-    if latvox::io::Format::from_path(&a.output).is_none() {
-        return Err(latvox::Error::invalid(format!(
-            "{}: unknown mesh extension (use .stl, .obj, .off, .ply or .3mf)",
-            a.output.display()
-        )));
-    }
+    let output = MeshFile::new(&a.output, a.ascii)?;
     if let Some(r) = &a.common.report {
         latvox::output::check_writable(r)?;
     }
@@ -75,14 +71,7 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
         remesh: a.remesh,
     };
     let progress = latvox::progress::Progress::new(quiet);
-    let r = repair_file(
-        &a.input,
-        &a.output,
-        a.ascii,
-        &a.common.options(),
-        &opts,
-        &progress,
-    )?;
+    let r = repair_file(&a.input, &output, &a.common.options(), &opts, &progress)?;
     if !super::emit_json(a.common.report.as_deref(), a.common.json, &r)? {
         print_header(&r.input, r.format, r.before.facets, &r.reading);
         let d = &r.defects_before.0;

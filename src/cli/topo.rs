@@ -2,7 +2,7 @@
 
 use super::{cgal_findings, write_json};
 use clap::Args;
-use latvox::io::stl::StlFormat;
+use latvox::sink::MeshFile;
 use latvox::topo::job::{self, TopoJob};
 use latvox::topo::volume::Smoothing;
 use latvox::topo::{CleanOptions, Density};
@@ -74,10 +74,10 @@ pub struct TopoArgs {
     /// Max deviation of the CAD curves from the boundary, mm (default: half a refined pixel).
     #[arg(long, value_name = "MM")]
     pub tolerance: Option<f64>,
-    /// Output STL.
+    /// Output mesh, in the format its extension names: .stl, .obj, .off, .ply or .3mf.
     #[arg(long, short = 'o', value_name = "FILE.stl", default_value = "part.stl")]
     pub output: PathBuf,
-    /// Write ASCII STL.
+    /// Write ASCII STL (or ASCII PLY).
     #[arg(long)]
     pub ascii: bool,
     /// IGES file of the adaptive B-spline curves (2D).
@@ -175,14 +175,10 @@ pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
     for f in outputs.into_iter().flatten() {
         latvox::output::check_writable(f)?;
     }
+    let output = MeshFile::new(&a.output, a.ascii)?;
     let progress = latvox::progress::Progress::new(quiet);
     let r = job::run(&d, &job, &progress)?;
-    let format = if a.ascii {
-        StlFormat::Ascii
-    } else {
-        StlFormat::Binary
-    };
-    latvox::io::stl::save(&r.mesh, format, &a.output)?;
+    output.save(&r.mesh)?;
     let stamp = timestamp();
     let name = |p: &PathBuf| {
         p.file_name()

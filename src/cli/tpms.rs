@@ -5,7 +5,7 @@ use super::{
     parse_tile, parse_unit, write_json,
 };
 use clap::Args;
-use latvox::io::stl::StlFormat;
+use latvox::sink::MeshFile;
 use latvox::tpms::{Domain, Structure, Surface, TpmsJob, TpmsReport};
 use latvox::{Error, Result};
 use std::path::PathBuf;
@@ -67,16 +67,17 @@ pub struct TpmsArgs {
     /// OpenVDB mesh adaptivity: 0 keeps uniform triangles, up to 1 merges flat regions.
     #[arg(long, default_value_t = 0.0, value_parser = parse_unit)]
     pub adaptivity: f64,
-    /// Output mesh: binary STL (ASCII with --ascii), or a 3MF package when the name ends in
-    /// .3mf; streamed to the file as it is made.
+    /// Output mesh, in the format its extension names: .stl (binary, ASCII with --ascii) or
+    /// .3mf, streamed to the file as it is made; .obj, .off or .ply (binary, ASCII with
+    /// --ascii), written once the part is whole.
     #[arg(
         long,
         short = 'o',
-        value_name = "FILE.stl|FILE.3mf",
+        value_name = "FILE.stl|.3mf|.obj|.off|.ply",
         default_value = "lattice.stl"
     )]
     pub output: PathBuf,
-    /// Write ASCII STL instead of binary.
+    /// Write ASCII STL (or ASCII PLY) instead of binary.
     #[arg(long)]
     pub ascii: bool,
     /// Write a JSON report (type, level, densities, mesh counts, CGAL checks, timings).
@@ -168,13 +169,8 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
         memory: a.memory,
     };
     latvox::output::check_writable(&a.output)?;
-    let format = if a.ascii {
-        StlFormat::Ascii
-    } else {
-        StlFormat::Binary
-    };
-    // The part streams into a temporary file that becomes the output only once the job is done.
-    let mut sink = latvox::sink::FileSink::create(&a.output, format)?;
+    // The part goes to a temporary file that becomes the output only once the job is done.
+    let mut sink = MeshFile::new(&a.output, a.ascii)?.sink()?;
     let mut report = job.run_into(progress, &mut sink)?;
     sink.commit()?;
     report.output = Some(a.output.display().to_string());

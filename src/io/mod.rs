@@ -188,17 +188,6 @@ pub fn write(
     }
 }
 
-/// Writes `mesh` to `path` atomically, in the format its extension names.
-pub fn save(mesh: &Mesh, path: &Path, ascii: bool) -> Result<()> {
-    let format = Format::from_path(path).ok_or_else(|| {
-        Error::invalid(format!(
-            "{}: unknown mesh extension (use .stl, .obj, .off, .ply or .3mf)",
-            path.display()
-        ))
-    })?;
-    crate::output::write_atomic(path, |w| write(mesh, format, ascii, w))
-}
-
 /// Collects polygons from an indexed-format reader and turns them into a welded triangle mesh.
 pub(crate) struct PolygonSink {
     pub positions: Vec<f32>,

@@ -6,6 +6,7 @@ use crate::check::{check, read_file, CheckOptions, CheckReport, Defects, Verdict
 use crate::error::{Error, Result};
 use crate::io::{Format, ReadOptions, Reading};
 use crate::progress::Progress;
+use crate::sink::MeshFile;
 use std::path::Path;
 
 /// Everything `latvox repair` reports.
@@ -36,13 +37,12 @@ pub struct FileRepairReport {
     pub verdict: Verdict,
 }
 
-/// Reads `input`, checks it, repairs it, writes the result to `output` atomically (in the format
-/// its extension names; `ascii` for ASCII STL or PLY) and checks the file as written. Vertices closer than `check_opts.tolerance` merge on reading the input. A
+/// Reads `input`, checks it, repairs it, writes the result to `output` atomically and checks the
+/// file as written. Vertices closer than `check_opts.tolerance` merge on reading the input. A
 /// repair that leaves no facet is an error, and nothing is written.
 pub fn repair_file(
     input: &Path,
-    output: &Path,
-    ascii: bool,
+    output: &MeshFile,
     check_opts: &CheckOptions,
     opts: &RepairOptions,
     progress: &Progress,
@@ -72,13 +72,13 @@ pub fn repair_file(
     }
     {
         let _s = progress.stage("writing");
-        crate::io::save(&mesh, output, ascii)?;
+        output.save(&mesh)?;
     }
     // The verdict is on the file as written and read back, as the next program will see it
     // (STL, for one, welds vertices by position).
     let after = {
         let _s = progress.stage("checking the written file");
-        let written = crate::io::read(output, &ReadOptions::default())?;
+        let written = crate::io::read(&output.path, &ReadOptions::default())?;
         check(&written.mesh, written.normals.as_deref(), check_opts)?
     };
     let normals_recomputed = before
@@ -87,7 +87,7 @@ pub fn repair_file(
         .unwrap_or(0);
     Ok(FileRepairReport {
         input: input.display().to_string(),
-        output: output.display().to_string(),
+        output: output.path.display().to_string(),
         format: loaded.format,
         reading: loaded.reading(),
         defects_before: Defects::from(&before),
