@@ -521,3 +521,75 @@ fn output_format_follows_the_extension() {
     );
     assert!(files_in(&empty).is_empty());
 }
+
+/// A reader that stops early (`latvox check big.stl --json | head -1`) ends latvox quietly
+/// with exit code 0, as it does a summary printed into a pipe already closed.
+#[test]
+fn a_closed_pipe_ends_quietly() {
+    use std::io::BufRead;
+    use std::process::Stdio;
+    let dir = tempdir();
+    // 2,000 separate tetrahedra and one lone facet: about 1 MB of JSON, far more than a pipe
+    // holds, and exit code 1 (an open shell) when read to the end.
+    let mut stl = String::from("solid many\n");
+    let mut facet = |p: [[f64; 3]; 3]| {
+        stl.push_str("facet normal 0 0 0\nouter loop\n");
+        for q in p {
+            stl.push_str(&format!("vertex {} {} {}\n", q[0], q[1], q[2]));
+        }
+        stl.push_str("endloop\nendfacet\n");
+    };
+    for i in 0..2000 {
+        let o = [(i % 50) as f64 * 2.0, (i / 50) as f64 * 2.0, 0.0];
+        let p = |d: [f64; 3]| [o[0] + d[0], o[1] + d[1], o[2] + d[2]];
+        let [a, b, c, d] = [
+            p([0.0, 0.0, 0.0]),
+            p([1.0, 0.0, 0.0]),
+            p([0.0, 1.0, 0.0]),
+            p([0.0, 0.0, 1.0]),
+        ];
+        for t in [[a, c, b], [a, b, d], [a, d, c], [b, c, d]] {
+            facet(t);
+        }
+    }
+    facet([[0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0]]);
+    stl.push_str("endsolid many\n");
+    std::fs::write(dir.path().join("many.stl"), stl).unwrap();
+    let args = ["check", "many.stl", "--json", "--no-self-intersection"];
+    let whole = run(&args, dir.path());
+    assert_eq!(whole.status.code(), Some(1));
+    assert!(whole.stdout.len() > 1 << 18, "{} bytes", whole.stdout.len());
+
+    let mut child = latvox()
+        .args(args)
+        .current_dir(dir.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    {
+        let mut head = std::io::BufReader::new(child.stdout.take().unwrap());
+        head.read_line(&mut first).unwrap();
+    } // The read end closes here.
+    assert_eq!(first.trim_end(), "{");
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.is_empty(), "{err}");
+
+    // A summary printed into a pipe closed before the first line.
+    let mut child = latvox()
+        .args(["tpms", "--cells", "1", "-r", "8", "-q", "-o", "one.stl"])
+        .current_dir(dir.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.is_empty(), "{err}");
+    assert!(dir.path().join("one.stl").exists());
+}

@@ -9,6 +9,7 @@
 //! A subcommand joins the batch by implementing [`Task`] for its `Args` and adding one line to
 //! [`COMMANDS`].
 
+use super::out::outln;
 use super::tpms::TpmsArgs;
 use clap::{Args, FromArgMatches};
 use latvox::batch::{self, Event, Job, JobFile, Settings, Shard, Status, Task, TaskReport, Value};
@@ -253,7 +254,7 @@ pub fn run(a: &BatchArgs, quiet: bool) -> Result<i32> {
                     1 => " on 1 worker".into(),
                     w => format!(" on {w} workers"),
                 };
-                println!(
+                outln!(
                     "batch {name}: {} jobs{shard_note}: {jobs} here, {skipped} already done, {to_run} to run{on}",
                     file.jobs.len(),
                 );
@@ -280,7 +281,7 @@ pub fn run(a: &BatchArgs, quiet: bool) -> Result<i32> {
                 } else if r.status == Status::Defects {
                     line.push_str(&format!(": checks found defects (see {})", r.name.report));
                 }
-                c.println(&line);
+                c.suspend(|| outln!("{line}"));
             }
         }
     })?;
@@ -304,13 +305,10 @@ pub fn run(a: &BatchArgs, quiet: bool) -> Result<i32> {
     summary.write_csv(&csv)?;
     summary.write_json(&json)?;
     if a.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&summary).map_err(|e| Error::invalid(e.to_string()))?
-        );
+        super::out::json(&summary);
     } else {
         let c = summary.counts;
-        println!(
+        outln!(
             "done {:.1} s: {} ok, {} skipped (done before), {} with defects, {} failed · summary {}",
             summary.seconds,
             c.ok,
@@ -326,13 +324,10 @@ pub fn run(a: &BatchArgs, quiet: bool) -> Result<i32> {
 fn dry_run(file: &JobFile, tasks: &[&dyn Task], settings: Settings, json: bool) -> Result<i32> {
     let jobs = batch::plan(file, tasks, settings);
     if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&jobs).map_err(|e| Error::invalid(e.to_string()))?
-        );
+        super::out::json(&jobs);
     } else {
         for j in &jobs {
-            println!(
+            outln!(
                 "#{:<5} {:<9} {} {}  ({})",
                 j.name.job,
                 if j.done { "done" } else { "to run" },

@@ -2,6 +2,7 @@
 //! verdict), as a summary or as JSON.
 
 use super::cgal_findings;
+use super::out::outln;
 use clap::Args;
 use latvox::check::{check_file, CheckOptions, CheckReport, Orientation};
 use latvox::io::{Format, Reading};
@@ -68,8 +69,8 @@ pub fn run(a: &CheckArgs, quiet: bool) -> Result<i32> {
     if !super::emit_json(a.common.report.as_deref(), a.common.json, &r)? {
         print_header(&r.file, r.format, r.triangles, &r.reading);
         print_summary(&r.check);
-        println!("CGAL      {}", cgal_findings(&r.cgal));
-        println!(
+        outln!("CGAL      {}", cgal_findings(&r.cgal));
+        outln!(
             "verdict   {}",
             if r.verdict.is_valid_solid() {
                 "valid closed solid"
@@ -83,7 +84,7 @@ pub fn run(a: &CheckArgs, quiet: bool) -> Result<i32> {
 
 /// The file line of a summary, and what reading did.
 pub(crate) fn print_header(file: &str, format: Format, facets: u64, r: &Reading) {
-    println!("{file} ({}, {facets} facets read)", format.name());
+    outln!("{file} ({}, {facets} facets read)", format.name());
     let mut notes = Vec::new();
     if r.polygons_split_into_triangles > 0 {
         notes.push(format!(
@@ -104,38 +105,42 @@ pub(crate) fn print_header(file: &str, format: Format, facets: u64, r: &Reading)
         ));
     }
     if !notes.is_empty() {
-        println!("reading   {}", notes.join(", "));
+        outln!("reading   {}", notes.join(", "));
     }
 }
 
 /// The human-readable summary of a check.
 pub(crate) fn print_summary(r: &CheckReport) {
-    println!(
+    outln!(
         "mesh      facets {}  vertices {}  edges {}  shells {}",
-        r.facets, r.vertices, r.edges, r.shell_count
+        r.facets,
+        r.vertices,
+        r.edges,
+        r.shell_count
     );
-    println!(
+    outln!(
         "measures  volume {:.4} mm³  area {:.4} mm²",
-        r.volume, r.area
+        r.volume,
+        r.area
     );
     let d = r.defects();
     if d.is_empty() {
-        println!("defects   none");
+        outln!("defects   none");
     } else {
         for (k, n) in &d {
-            println!("defect    {n} {k}");
+            outln!("defect    {n} {k}");
         }
     }
     if let Some(n) = r.normals {
         if n.unset > 0 {
-            println!(
+            outln!(
                 "note      {} stored normals are unset (zero or not finite)",
                 n.unset
             );
         }
     }
     if r.self_intersections.is_none() {
-        println!("note      self-intersections not checked");
+        outln!("note      self-intersections not checked");
     }
     const SHOWN: usize = 12;
     for (i, s) in r.shells.iter().enumerate().take(SHOWN) {
@@ -149,7 +154,7 @@ pub(crate) fn print_summary(r: &CheckReport) {
             .genus
             .map(|g| format!("genus {g}"))
             .unwrap_or_else(|| "genus -".into());
-        println!(
+        outln!(
             "shell {:<3} F {} V {} E {}  χ {}  {genus}  {}  {orient}  volume {:.4} mm³  area {:.4} mm²{}",
             i + 1,
             s.facets,
@@ -170,7 +175,7 @@ pub(crate) fn print_summary(r: &CheckReport) {
         );
     }
     if r.shells.len() > SHOWN {
-        println!(
+        outln!(
             "…         {} more shells (see --json)",
             r.shells.len() - SHOWN
         );

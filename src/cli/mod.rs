@@ -3,6 +3,7 @@
 
 pub mod batch;
 pub mod check;
+pub(crate) mod out;
 pub mod repair;
 pub mod topo;
 pub mod topopt;
@@ -138,10 +139,7 @@ pub(crate) fn emit_json(
         write_json(r, value)?;
     }
     if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(value).expect("JSON of plain values")
-        );
+        out::json(value);
     }
     Ok(json)
 }

@@ -2,6 +2,7 @@
 //! before and after.
 
 use super::check::{print_header, print_summary};
+use super::out::outln;
 use clap::Args;
 use latvox::repair::{repair_file, RepairOptions};
 use latvox::sink::MeshFile;
@@ -76,29 +77,29 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
         print_header(&r.input, r.format, r.before.facets, &r.reading);
         let d = &r.defects_before.0;
         if d.is_empty() {
-            println!("before    no defects (self-intersections are checked on the result)");
+            outln!("before    no defects (self-intersections are checked on the result)");
         } else {
             let list: Vec<String> = d.iter().map(|(k, n)| format!("{n} {k}")).collect();
-            println!(
+            outln!(
                 "before    {} (self-intersections are checked on the result)",
                 list.join(", ")
             );
         }
         let changes = &r.repair;
         if changes.changes.is_empty() && r.normals_recomputed == 0 {
-            println!("changes   none (the mesh is written unchanged)");
+            outln!("changes   none (the mesh is written unchanged)");
         }
         for c in &changes.changes {
-            println!("changed   {} {}", c.count, c.kind);
+            outln!("changed   {} {}", c.count, c.kind);
         }
         if r.normals_recomputed > 0 {
-            println!(
+            outln!(
                 "changed   {} stored normals recomputed from the winding",
                 r.normals_recomputed
             );
         }
         for s in &changes.open_shells {
-            println!(
+            outln!(
                 "open      a shell of {} facets still has {} boundary edges ({} hole loops){}",
                 s.facets,
                 s.boundary_edges,
@@ -111,17 +112,17 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
             );
         }
         if changes.non_orientable_shells > 0 {
-            println!(
+            outln!(
                 "open      {} shell(s) cannot be wound consistently (one-sided)",
                 changes.non_orientable_shells
             );
         }
-        println!("after ({})", r.output);
+        outln!("after ({})", r.output);
         print_summary(&r.after);
         if r.verdict.self_intersecting && a.remesh.is_none() {
-            println!("hint      self-intersections remain: --remesh VOXEL rebuilds the part without them");
+            outln!("hint      self-intersections remain: --remesh VOXEL rebuilds the part without them");
         }
-        println!(
+        outln!(
             "verdict   {}",
             if r.verdict.is_valid_solid() {
                 "valid closed solid"

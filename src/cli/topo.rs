@@ -1,5 +1,6 @@
 //! `latvox topo`: a density field to a printable STL and parametric CAD (seed 003).
 
+use super::out::outln;
 use super::{cgal_findings, write_json};
 use clap::Args;
 use latvox::sink::MeshFile;
@@ -289,15 +290,19 @@ fn summary(r: &job::TopoReport, a: &TopoArgs, images: &[PathBuf]) {
     } else {
         format!("{}×{}", r.dims[0], r.dims[1])
     };
-    println!(
+    outln!(
         "input     {dims} elements of {} mm, refined ×{} to {} mm pixels",
-        r.element_size, r.job.clean.refine, r.pixel_size
+        r.element_size,
+        r.job.clean.refine,
+        r.pixel_size
     );
-    println!(
+    outln!(
         "initial   thin-feature pixels {}, islands {}, point contacts {}",
-        r.initial.thin_pixels, r.initial.islands, r.initial.point_contacts
+        r.initial.thin_pixels,
+        r.initial.islands,
+        r.initial.point_contacts
     );
-    println!(
+    outln!(
         "cleaned   {} after {} pass(es): thin {}, islands {}, contacts {} (level {:.4})",
         if r.clean { "clean" } else { "NOT CLEAN" },
         r.iterations,
@@ -307,19 +312,19 @@ fn summary(r: &job::TopoReport, a: &TopoArgs, images: &[PathBuf]) {
         r.level
     );
     let unit = if r.is_3d { "mm³" } else { "mm²" };
-    println!(
+    outln!(
         "volume    thresholded {:.3} {unit}, final {:.3} {unit} ({:+.3} %)",
         r.thresholded_measure,
         r.final_measure,
         100.0 * r.measure_change
     );
-    println!(
+    outln!(
         "mesh      {} triangles; CGAL {}",
         r.triangles,
         cgal_findings(&r.checks)
     );
     if !r.loops.is_empty() {
-        println!(
+        outln!(
             "curves    {} loop(s): uniform {} control points, adaptive {} ({:.0} %), tolerance {} mm",
             r.loops.len(),
             r.uniform_control_points,
@@ -328,15 +333,15 @@ fn summary(r: &job::TopoReport, a: &TopoArgs, images: &[PathBuf]) {
             r.job.tolerance
         );
     }
-    println!("time      {:.3} s", r.timings.total);
-    println!("wrote     {}", a.output.display());
+    outln!("time      {:.3} s", r.timings.total);
+    outln!("wrote     {}", a.output.display());
     for p in [&a.iges, &a.dxf, &a.report, &a.cleaned]
         .into_iter()
         .flatten()
     {
-        println!("wrote     {}", p.display());
+        outln!("wrote     {}", p.display());
     }
     for p in images {
-        println!("wrote     {}", p.display());
+        outln!("wrote     {}", p.display());
     }
 }

@@ -1,5 +1,6 @@
 //! `latvox tpms`: a closed TPMS lattice at an exact volume fraction.
 
+use super::out::outln;
 use super::{
     cgal_findings, parse_counts, parse_density, parse_finite3, parse_positive3, parse_size,
     parse_tile, parse_unit, write_json,
@@ -178,7 +179,7 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
 }
 
 fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
-    println!(
+    outln!(
         "{} {} · {}×{}×{} cells of {}×{}×{} mm · {} voxels/cell ({:.4} mm)",
         r.surface.name(),
         r.structure.name(),
@@ -191,11 +192,14 @@ fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
         r.resolution,
         r.voxel_size
     );
-    println!(
+    outln!(
         "density   target {:.4}  achieved {:.4}  (error {:+.5}, level t = {:.5})",
-        r.target_density, r.achieved_density, r.density_error, r.level
+        r.target_density,
+        r.achieved_density,
+        r.density_error,
+        r.level
     );
-    println!(
+    outln!(
         "mesh      {} triangles, {} vertices, area {:.2} mm², volume {:.2} mm³",
         r.triangles,
         r.vertices,
@@ -203,18 +207,23 @@ fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
         r.volume.unwrap_or(f64::NAN)
     );
     if let Some(b) = r.bounding_box {
-        println!(
+        outln!(
             "bounds    [{:.3}, {:.3}, {:.3}] – [{:.3}, {:.3}, {:.3}] mm",
-            b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]
+            b.min[0],
+            b.min[1],
+            b.min[2],
+            b.max[0],
+            b.max[1],
+            b.max[2]
         );
     }
-    println!("CGAL      {}", cgal_findings(&r.checks));
+    outln!("CGAL      {}", cgal_findings(&r.checks));
     let t = &r.timings;
-    println!(
+    outln!(
         "time      {:.3} s (calibrate {:.3}, sample {:.3}, mesh {:.3}, snap {:.3}, verify {:.3}, write {:.3})",
         t.total, t.calibrate, t.sample, t.mesh, t.snap, t.verify, t.write
     );
     if let Some(o) = &r.output {
-        println!("wrote     {o}");
+        outln!("wrote     {o}");
     }
 }
