@@ -11,6 +11,12 @@
 //! edge counted in one class. Self-intersections are counted by CGAL among the facets that are
 //! neither degenerate nor duplicates (those are counted on their own).
 
+mod file;
+pub(crate) mod verdict;
+
+pub use file::{check_file, read_file, Defects, FileCheckReport};
+pub use verdict::Verdict;
+
 use crate::error::Result;
 use crate::field::Vec3;
 use crate::mesh::{cross, dot, norm, sub, Mesh};
@@ -131,12 +137,18 @@ pub struct CheckReport {
     /// Sum of the shells' signed volumes, mm³.
     pub volume: f64,
     pub area: f64,
-    /// A valid closed, outward, self-intersection-free solid with sound normals.
+    /// A valid closed, outward, self-intersection-free solid with sound normals: this report's
+    /// [`Verdict`].
     pub valid_solid: bool,
     pub shells: Vec<ShellReport>,
 }
 
 impl CheckReport {
+    /// The verdict on these findings.
+    pub fn verdict(&self) -> Verdict {
+        Verdict::from(self)
+    }
+
     /// The defect classes found, with their counts (empty when the mesh is valid).
     pub fn defects(&self) -> Vec<(&'static str, u64)> {
         let n = self.normals.unwrap_or_default();
@@ -706,7 +718,7 @@ pub fn check(
         valid_solid: false,
         shells: std::mem::take(&mut shell_reports),
     };
-    report.valid_solid = report.defects().is_empty();
+    report.valid_solid = report.verdict().is_valid_solid();
     Ok(report)
 }
 

@@ -18,6 +18,10 @@ pub enum Error {
     /// A file was read but its contents are not what its format promises.
     #[error("{path}: {message}")]
     Format { path: PathBuf, message: String },
+    /// Bytes (or text) given to a parser are not what their format promises; the parser does not
+    /// know the file they came from ([`Error::in_file`] names it).
+    #[error("{0}")]
+    Parse(String),
     /// OpenVDB or CGAL threw.
     #[error("{context}: {message}")]
     Backend {
@@ -29,6 +33,23 @@ pub enum Error {
 impl Error {
     pub fn invalid(msg: impl Into<String>) -> Self {
         Error::Invalid(msg.into())
+    }
+
+    /// What a parser found wrong with its input.
+    pub fn parse(msg: impl Into<String>) -> Self {
+        Error::Parse(msg.into())
+    }
+
+    /// A parse error as found in the file `path` (a [`Error::Format`] naming it); other errors
+    /// unchanged.
+    pub fn in_file(self, path: impl Into<PathBuf>) -> Self {
+        match self {
+            Error::Parse(message) => Error::Format {
+                path: path.into(),
+                message,
+            },
+            e => e,
+        }
     }
 
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
@@ -48,7 +69,7 @@ impl Error {
     /// Process exit code for this error: 2 for bad input, 3 for a failure inside a backend.
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Invalid(_) | Error::Io { .. } | Error::Format { .. } => 2,
+            Error::Invalid(_) | Error::Io { .. } | Error::Format { .. } | Error::Parse(_) => 2,
             Error::Backend { .. } => 3,
         }
     }

@@ -1,17 +1,26 @@
 //! The `latvox` command line: parses arguments, calls the library, prints one line on error.
-//! Exit codes: 0 success, 1 a check found defects, 2 bad input or arguments, 3 backend failure.
+//! Exit codes: 0 success, 1 a check found defects, 2 bad input or arguments, 3 a backend failed
+//! unexpectedly (a bug to report).
 
 use clap::{Parser, Subcommand};
 use latvox::Error;
 
 mod cli;
 
+const EXIT_CODES: &str = "\
+Exit codes (every command):
+  0  success; a part or mesh made or checked is a valid closed, outward solid
+  1  a check found defects (the output is still written), or a batch job failed
+  2  bad input or arguments: one line on stderr, no file written
+  3  a backend (OpenVDB or CGAL) failed unexpectedly: a bug to report";
+
 #[derive(Parser)]
 #[command(
     name = "latvox",
     version,
     about = "Sparse-volume voxel engine for additive manufacturing: TPMS lattices at exact density, verified by CGAL",
-    long_about = None
+    long_about = None,
+    after_help = EXIT_CODES
 )]
 struct Cli {
     /// Worker threads for latvox and OpenVDB/TBB (default: all cores).

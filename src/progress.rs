@@ -95,11 +95,11 @@ impl Counter {
         }
     }
 
-    /// Prints a line on stdout without tearing the bar.
-    pub fn println(&self, line: &str) {
+    /// Runs `print` (which writes to the terminal) without tearing the bar.
+    pub fn suspend<R>(&self, print: impl FnOnce() -> R) -> R {
         match &self.bar {
-            Some(b) => b.suspend(|| println!("{line}")),
-            None => println!("{line}"),
+            Some(b) => b.suspend(print),
+            None => print(),
         }
     }
 }

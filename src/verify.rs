@@ -2,6 +2,7 @@
 //! computed by CGAL's Polygon Mesh Processing on a Surface_mesh built from our triangles —
 //! an independent second measurement of every mesh latvox writes.
 
+use crate::check::Verdict;
 use crate::error::{Error, Result};
 use crate::ffi::cgal::ffi;
 use crate::mesh::Mesh;
@@ -30,13 +31,9 @@ pub struct Verification {
 }
 
 impl Verification {
-    /// A valid closed outward solid with no self-intersection.
-    pub fn is_valid_solid(&self) -> bool {
-        self.manifold
-            && self.closed
-            && self.outward
-            && self.self_intersection_checked
-            && !self.self_intersecting
+    /// The verdict on CGAL's findings.
+    pub fn verdict(&self) -> Verdict {
+        Verdict::from(self)
     }
 }
 

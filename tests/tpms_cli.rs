@@ -548,4 +548,160 @@ fn a_missing_folder_is_named_as_the_user_gave_it() {
         );
         assert!(files_in(dir.path()).is_empty());
     }
+
+/// Triangles of an OBJ file, read here: `v x y z` and `f a b c` lines (1-based, `a/t/n` corners
+/// allowed); also the number of `v` lines.
+fn read_obj(path: &std::path::Path) -> (Vec<Tri>, usize) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut v: Vec<[f64; 3]> = Vec::new();
+    let mut faces: Vec<[usize; 3]> = Vec::new();
+    for line in text.lines() {
+        let mut w = line.split_whitespace();
+        match w.next() {
+            Some("v") => {
+                let p: Vec<f64> = w.map(|s| s.parse().unwrap()).collect();
+                v.push([p[0], p[1], p[2]]);
+            }
+            Some("f") => {
+                let c: Vec<usize> = w
+                    .map(|s| s.split('/').next().unwrap().parse().unwrap())
+                    .collect();
+                assert_eq!(c.len(), 3, "{line}");
+                faces.push([c[0] - 1, c[1] - 1, c[2] - 1]);
+            }
+            _ => {}
+        }
+    }
+    let tris = faces.iter().map(|f| f.map(|i| v[i])).collect();
+    (tris, v.len())
+}
+
+/// `-o` names the format: `part.obj` is a real OBJ (each vertex listed once), closed and
+/// consistently wound, with the same triangles and volume as the `part.stl` of the same command;
+/// an unknown extension is refused before any work (the infeasible density below is never
+/// reached) and nothing is written.
+#[test]
+fn output_format_follows_the_extension() {
+    let dir = tempdir();
+    for out in ["part.stl", "part.obj"] {
+        let args = "tpms -t d -d 0.3 --cells 2 --cell-size 5 -r 16 -q -o";
+        let mut args: Vec<&str> = args.split(' ').collect();
+        args.push(out);
+        let o = run(&args, dir.path());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{out}: {err}");
+    }
+    let stl = read_stl(&dir.path().join("part.stl"));
+    let obj = dir.path().join("part.obj");
+    assert!(
+        !std::fs::read(&obj).unwrap().starts_with(b"binary STL"),
+        "part.obj holds STL bytes"
+    );
+    let (tris, vertices) = read_obj(&obj);
+    assert_eq!(tris.len(), stl.len());
+    assert_eq!(
+        edges(&tris),
+        Edges::default(),
+        "OBJ not closed and consistent"
+    );
+    // Exactly welded: every position once, so about half as many vertices as triangles.
+    let mut distinct: Vec<[u32; 3]> = tris
+        .iter()
+        .flatten()
+        .map(|p| p.map(|x| (x as f32).to_bits()))
+        .collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    assert_eq!(distinct.len(), vertices);
+    let (vs, vo) = (volume(&stl), volume(&tris));
+    assert!(vs > 0.0 && (vo - vs).abs() <= 1e-6 * vs, "{vo} vs {vs}");
+
+    let empty = dir.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    let out = run(
+        &[
+            "tpms", "-t", "p", "-d", "0.1", "-o", "part.xyz", "--report", "r.json",
+        ],
+        &empty,
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("part.xyz") && err.contains(".obj") && err.contains(".3mf"),
+        "{err}"
+    );
+    assert!(files_in(&empty).is_empty());
+}
+
+/// A reader that stops early (`latvox check big.stl --json | head -1`) ends latvox quietly
+/// with exit code 0, as it does a summary printed into a pipe already closed.
+#[test]
+fn a_closed_pipe_ends_quietly() {
+    use std::io::BufRead;
+    use std::process::Stdio;
+    let dir = tempdir();
+    // 2,000 separate tetrahedra and one lone facet: about 1 MB of JSON, far more than a pipe
+    // holds, and exit code 1 (an open shell) when read to the end.
+    let mut stl = String::from("solid many\n");
+    let mut facet = |p: [[f64; 3]; 3]| {
+        stl.push_str("facet normal 0 0 0\nouter loop\n");
+        for q in p {
+            stl.push_str(&format!("vertex {} {} {}\n", q[0], q[1], q[2]));
+        }
+        stl.push_str("endloop\nendfacet\n");
+    };
+    for i in 0..2000 {
+        let o = [(i % 50) as f64 * 2.0, (i / 50) as f64 * 2.0, 0.0];
+        let p = |d: [f64; 3]| [o[0] + d[0], o[1] + d[1], o[2] + d[2]];
+        let [a, b, c, d] = [
+            p([0.0, 0.0, 0.0]),
+            p([1.0, 0.0, 0.0]),
+            p([0.0, 1.0, 0.0]),
+            p([0.0, 0.0, 1.0]),
+        ];
+        for t in [[a, c, b], [a, b, d], [a, d, c], [b, c, d]] {
+            facet(t);
+        }
+    }
+    facet([[0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0]]);
+    stl.push_str("endsolid many\n");
+    std::fs::write(dir.path().join("many.stl"), stl).unwrap();
+    let args = ["check", "many.stl", "--json", "--no-self-intersection"];
+    let whole = run(&args, dir.path());
+    assert_eq!(whole.status.code(), Some(1));
+    assert!(whole.stdout.len() > 1 << 18, "{} bytes", whole.stdout.len());
+
+    let mut child = latvox()
+        .args(args)
+        .current_dir(dir.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    {
+        let mut head = std::io::BufReader::new(child.stdout.take().unwrap());
+        head.read_line(&mut first).unwrap();
+    } // The read end closes here.
+    assert_eq!(first.trim_end(), "{");
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.is_empty(), "{err}");
+
+    // A summary printed into a pipe closed before the first line.
+    let mut child = latvox()
+        .args(["tpms", "--cells", "1", "-r", "8", "-q", "-o", "one.stl"])
+        .current_dir(dir.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.is_empty(), "{err}");
+    assert!(dir.path().join("one.stl").exists());
 }

@@ -119,10 +119,7 @@ impl JobFile {
     /// Reads and expands the job file at `path`.
     pub fn load(path: &Path) -> Result<JobFile> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        let jobs = parse(&text).map_err(|message| Error::Format {
-            path: path.to_path_buf(),
-            message,
-        })?;
+        let jobs = parse(&text).map_err(|e| e.in_file(path))?;
         let dir = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
@@ -143,13 +140,13 @@ impl JobFile {
 type Table = Vec<(String, toml::Value)>;
 
 /// Parses job-file text into its expanded jobs; errors are one line, with the line number.
-pub fn parse(text: &str) -> std::result::Result<Vec<Job>, String> {
+pub fn parse(text: &str) -> Result<Vec<Job>> {
     let doc: toml::Table = text.parse().map_err(|e: toml::de::Error| {
         let line = e
             .span()
             .map(|s| format!("line {}: ", text[..s.start].lines().count().max(1)))
             .unwrap_or_default();
-        format!("{line}{}", e.message().trim())
+        Error::parse(format!("{line}{}", e.message().trim()))
     })?;
     let mut defaults = Table::new();
     let mut job_tables = Vec::new();
@@ -160,14 +157,16 @@ pub fn parse(text: &str) -> std::result::Result<Vec<Job>, String> {
             ("job", toml::Value::Array(a)) => job_tables = tables(a, "job")?,
             ("sweep", toml::Value::Array(a)) => sweep_tables = tables(a, "sweep")?,
             (k, _) => {
-                return Err(format!(
+                return Err(Error::parse(format!(
                     "unexpected '{k}': a job file holds [[job]] and [[sweep]] tables and one [defaults] table"
-                ))
+                )))
             }
         }
     }
     if job_tables.is_empty() && sweep_tables.is_empty() {
-        return Err("no [[job]] or [[sweep]] table: nothing to run".into());
+        return Err(Error::parse(
+            "no [[job]] or [[sweep]] table: nothing to run",
+        ));
     }
 
     let mut jobs = Vec::new();
@@ -176,7 +175,7 @@ pub fn parse(text: &str) -> std::result::Result<Vec<Job>, String> {
         let t = with_defaults(normalise(t, &origin)?, &defaults);
         let mut options = Vec::new();
         for (k, v) in t {
-            let v = value(&v).map_err(|m| format!("{origin}: '{k}': {m}"))?;
+            let v = value(&v).map_err(|m| Error::parse(format!("{origin}: '{k}': {m}")))?;
             options.push((k, v));
         }
         jobs.push(make_job(jobs.len(), origin, options)?);
@@ -190,14 +189,16 @@ pub fn parse(text: &str) -> std::result::Result<Vec<Job>, String> {
             let values = match &v {
                 toml::Value::Array(a) if k != "output" && k != "command" => {
                     if a.is_empty() {
-                        return Err(format!("{name}: '{k}' is an empty list: nothing to sweep"));
+                        return Err(Error::parse(format!(
+                            "{name}: '{k}' is an empty list: nothing to sweep"
+                        )));
                     }
                     a.iter()
                         .map(value)
                         .collect::<std::result::Result<Vec<_>, _>>()
-                        .map_err(|m| format!("{name}: '{k}': {m}"))?
+                        .map_err(|m| Error::parse(format!("{name}: '{k}': {m}")))?
                 }
-                _ => vec![value(&v).map_err(|m| format!("{name}: '{k}': {m}"))?],
+                _ => vec![value(&v).map_err(|m| Error::parse(format!("{name}: '{k}': {m}")))?],
             };
             axes.push((k, values));
         }
@@ -218,22 +219,24 @@ pub fn parse(text: &str) -> std::result::Result<Vec<Job>, String> {
     Ok(jobs)
 }
 
-fn tables(a: Vec<toml::Value>, what: &str) -> std::result::Result<Vec<toml::Table>, String> {
+fn tables(a: Vec<toml::Value>, what: &str) -> Result<Vec<toml::Table>> {
     a.into_iter()
         .map(|v| match v {
             toml::Value::Table(t) => Ok(t),
-            _ => Err(format!("'{what}' must be written as [[{what}]] tables")),
+            _ => Err(Error::parse(format!(
+                "'{what}' must be written as [[{what}]] tables"
+            ))),
         })
         .collect()
 }
 
 /// Keys with `_` read as `-` (clap's long names), refusing a key given both ways.
-fn normalise(t: toml::Table, origin: &str) -> std::result::Result<Table, String> {
+fn normalise(t: toml::Table, origin: &str) -> Result<Table> {
     let mut out: Table = Vec::new();
     for (k, v) in t {
         let key = k.replace('_', "-");
         if out.iter().any(|(o, _)| *o == key) {
-            return Err(format!("{origin}: '{key}' is given twice"));
+            return Err(Error::parse(format!("{origin}: '{key}' is given twice")));
         }
         out.push((key, v));
     }
@@ -249,66 +252,69 @@ fn with_defaults(mut t: Table, defaults: &Table) -> Table {
     t
 }
 
-fn value(v: &toml::Value) -> std::result::Result<Value, String> {
+fn value(v: &toml::Value) -> Result<Value> {
     Ok(match v {
         toml::Value::String(s) => Value::Str(s.clone()),
         toml::Value::Integer(i) => Value::Int(*i),
         toml::Value::Float(f) if f.is_finite() => Value::Float(*f),
-        toml::Value::Float(f) => return Err(format!("{f} is not a finite number")),
+        toml::Value::Float(f) => return Err(Error::parse(format!("{f} is not a finite number"))),
         toml::Value::Boolean(b) => Value::Bool(*b),
         toml::Value::Array(a) => Value::List(
             a.iter()
                 .map(|x| match x {
-                    toml::Value::Array(_) | toml::Value::Table(_) => {
-                        Err("a list inside a list is only allowed in a [[sweep]]".to_string())
-                    }
+                    toml::Value::Array(_) | toml::Value::Table(_) => Err(Error::parse(
+                        "a list inside a list is only allowed in a [[sweep]]",
+                    )),
                     x => value(x),
                 })
                 .collect::<std::result::Result<_, _>>()?,
         ),
-        toml::Value::Datetime(_) => return Err("dates are not option values".into()),
-        toml::Value::Table(_) => return Err("a table is not an option value".into()),
+        toml::Value::Datetime(_) => return Err(Error::parse("dates are not option values")),
+        toml::Value::Table(_) => return Err(Error::parse("a table is not an option value")),
     })
 }
 
-fn make_job(
-    index: usize,
-    origin: String,
-    options: Vec<(String, Value)>,
-) -> std::result::Result<Job, String> {
-    let text = |key: &str| -> std::result::Result<Option<String>, String> {
+fn make_job(index: usize, origin: String, options: Vec<(String, Value)>) -> Result<Job> {
+    let text = |key: &str| -> Result<Option<String>> {
         match options.iter().find(|(k, _)| k == key) {
             None => Ok(None),
             Some((_, Value::Str(s))) if !s.trim().is_empty() => Ok(Some(s.clone())),
-            Some(_) => Err(format!("{origin}: '{key}' must be a non-empty string")),
+            Some(_) => Err(Error::parse(format!(
+                "{origin}: '{key}' must be a non-empty string"
+            ))),
         }
     };
     let command = text("command")?.ok_or_else(|| {
-        format!("{origin}: no 'command' (the latvox subcommand to run, e.g. command = \"tpms\")")
+        Error::parse(format!(
+            "{origin}: no 'command' (the latvox subcommand to run, e.g. command = \"tpms\")"
+        ))
     })?;
     let pattern = text("output")?
-        .ok_or_else(|| format!("{origin}: no 'output' (the file the job writes)"))?;
+        .ok_or_else(|| Error::parse(format!("{origin}: no 'output' (the file the job writes)")))?;
     let report_pattern = text("report")?;
     let mut options: Vec<(String, Value)> = options
         .into_iter()
         .filter(|(k, _)| k != "command" && k != "report")
         .collect();
-    let output = expand(&pattern, &options).map_err(|m| format!("{origin}: output: {m}"))?;
+    let output =
+        expand(&pattern, &options).map_err(|m| Error::parse(format!("{origin}: output: {m}")))?;
     for (k, v) in options.iter_mut() {
         if k == "output" {
             *v = Value::Str(output.clone());
         }
     }
     let report = match report_pattern {
-        Some(p) => expand(&p, &options).map_err(|m| format!("{origin}: report: {m}"))?,
+        Some(p) => {
+            expand(&p, &options).map_err(|m| Error::parse(format!("{origin}: report: {m}")))?
+        }
         None => {
             let p = Path::new(&output);
             if p.extension()
                 .is_some_and(|e| e.eq_ignore_ascii_case("json"))
             {
-                return Err(format!(
+                return Err(Error::parse(format!(
                     "{origin}: the output '{output}' is a .json file; give the report its own name with report = \"...\""
-                ));
+                )));
             }
             p.with_extension("json").to_string_lossy().into_owned()
         }
@@ -326,23 +332,23 @@ fn make_job(
 }
 
 /// Fills `{key}` in an output pattern with that option's value (lists as `4x4x2`).
-fn expand(pattern: &str, options: &[(String, Value)]) -> std::result::Result<String, String> {
+fn expand(pattern: &str, options: &[(String, Value)]) -> Result<String> {
     let mut out = String::new();
     let mut rest = pattern;
     while let Some(open) = rest.find(['{', '}']) {
         out.push_str(&rest[..open]);
         if rest[open..].starts_with('}') {
-            return Err(format!("'}}' without '{{' in '{pattern}'"));
+            return Err(Error::parse(format!("'}}' without '{{' in '{pattern}'")));
         }
         let close = rest[open..]
             .find('}')
-            .ok_or_else(|| format!("'{{' without '}}' in '{pattern}'"))?
+            .ok_or_else(|| Error::parse(format!("'{{' without '}}' in '{pattern}'")))?
             + open;
         let key = rest[open + 1..close].trim().replace('_', "-");
         let v = options
             .iter()
             .find(|(k, _)| *k == key && k != "output")
-            .ok_or_else(|| format!("'{{{key}}}' names no option of this job"))?;
+            .ok_or_else(|| Error::parse(format!("'{{{key}}}' names no option of this job")))?;
         out.push_str(&v.1.to_name());
         rest = &rest[close + 1..];
     }
@@ -351,7 +357,7 @@ fn expand(pattern: &str, options: &[(String, Value)]) -> std::result::Result<Str
 }
 
 /// Two jobs writing the same file would overwrite each other: refuse before running anything.
-fn check_distinct(jobs: &[Job]) -> std::result::Result<(), String> {
+fn check_distinct(jobs: &[Job]) -> Result<()> {
     let mut seen: std::collections::HashMap<PathBuf, (usize, &str)> = Default::default();
     for j in jobs {
         for (what, p) in [("output", &j.output), ("report", &j.report)] {
@@ -362,10 +368,10 @@ fn check_distinct(jobs: &[Job]) -> std::result::Result<(), String> {
                 } else {
                     ""
                 };
-                return Err(format!(
+                return Err(Error::parse(format!(
                     "{} and {} both write '{p}' (as {other_what} and {what}){hint}",
                     o.origin, j.origin
-                ));
+                )));
             }
         }
     }
@@ -502,7 +508,7 @@ mod tests {
             ("[[job]]\ncommand = 'tpms'\noutput = \n", "line 3"),
         ];
         for (text, want) in cases {
-            let e = parse(text).unwrap_err();
+            let e = parse(text).unwrap_err().to_string();
             assert!(e.contains(want), "{text:?}: got {e:?}, want {want:?}");
             assert!(!e.contains('\n'), "{e:?}");
         }

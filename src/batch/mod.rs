@@ -19,6 +19,6 @@ pub mod summary;
 
 pub use jobfile::{Job, JobFile, Value};
 pub use resume::Provenance;
-pub use run::{previous_run, run, Event, Settings, Task, TaskReport};
+pub use run::{plan, previous_run, run, Event, PlannedJob, Settings, Task, TaskReport};
 pub use shard::Shard;
-pub use summary::{Counts, JobResult, Status, Summary};
+pub use summary::{Counts, JobName, JobResult, Status, Summary};

@@ -9,7 +9,7 @@
 use super::jobfile::{Job, JobFile};
 use super::resume::{self, FileRecord, Outcome, Provenance, SlurmIds};
 use super::shard::Shard;
-use super::summary::{Counts, JobResult, Status, Summary};
+use super::summary::{Counts, JobName, JobResult, Status, Summary};
 use crate::error::{Error, Result};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -54,6 +54,31 @@ pub enum Event<'a> {
     },
     /// A job ran (or failed).
     Done(&'a JobResult),
+}
+
+/// A job as a dry run lists it: where it comes from, what it writes, and whether it is done.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct PlannedJob {
+    #[serde(flatten)]
+    pub name: JobName,
+    /// A previous run is still valid (and `force` is off): running the batch skips it.
+    pub done: bool,
+    pub options: serde_json::Value,
+}
+
+/// The jobs of this shard, in order, each with whether running the batch would skip it;
+/// `tasks[i]` is the task of `file.jobs[i]`.
+pub fn plan(file: &JobFile, tasks: &[&dyn Task], settings: Settings) -> Vec<PlannedJob> {
+    file.jobs
+        .iter()
+        .zip(tasks)
+        .filter(|(job, _)| settings.shard.is_none_or(|s| s.contains(job.index)))
+        .map(|(job, task)| PlannedJob {
+            name: JobName::from(job),
+            done: !settings.force && previous_run(file, job, *task).is_some(),
+            options: job.options_json(),
+        })
+        .collect()
 }
 
 /// The job's previous run, if it is still valid (see [`resume::completed`]).
@@ -132,7 +157,7 @@ pub fn run(
             results.push(r);
         }
     });
-    results.sort_by_key(|r| r.job);
+    results.sort_by_key(|r| r.name.job);
     Ok(Summary {
         job_file: file.path.to_string_lossy().into_owned(),
         jobs_in_batch: file.jobs.len(),

@@ -31,9 +31,9 @@ impl Status {
     }
 }
 
-/// One row of the summary.
+/// A job as listings and summaries name it.
 #[derive(Debug, Clone, Serialize)]
-pub struct JobResult {
+pub struct JobName {
     /// Number of the job in the batch, from 1.
     pub job: usize,
     pub origin: String,
@@ -41,6 +41,26 @@ pub struct JobResult {
     pub output: String,
     pub report: String,
     pub hash: String,
+}
+
+impl From<&Job> for JobName {
+    fn from(job: &Job) -> JobName {
+        JobName {
+            job: job.index + 1,
+            origin: job.origin.clone(),
+            command: job.command.clone(),
+            output: job.output.clone(),
+            report: job.report.clone(),
+            hash: job.hash.clone(),
+        }
+    }
+}
+
+/// One row of the summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct JobResult {
+    #[serde(flatten)]
+    pub name: JobName,
     pub status: Status,
     /// Wall time of this run of the job (0 when skipped).
     pub seconds: f64,
@@ -53,12 +73,7 @@ pub struct JobResult {
 impl JobResult {
     pub(crate) fn new(job: &Job, status: Status, seconds: f64, run_id: Option<String>) -> Self {
         JobResult {
-            job: job.index + 1,
-            origin: job.origin.clone(),
-            command: job.command.clone(),
-            output: job.output.clone(),
-            report: job.report.clone(),
-            hash: job.hash.clone(),
+            name: JobName::from(job),
             status,
             seconds,
             run_id,
@@ -125,15 +140,16 @@ impl Summary {
                 "job,status,seconds,output,report,command,origin,hash,run_id,warnings,error"
             )?;
             for r in &self.jobs {
+                let n = &r.name;
                 let fields = [
-                    r.job.to_string(),
+                    n.job.to_string(),
                     r.status.name().to_string(),
                     format!("{:.3}", r.seconds),
-                    r.output.clone(),
-                    r.report.clone(),
-                    r.command.clone(),
-                    r.origin.clone(),
-                    r.hash.clone(),
+                    n.output.clone(),
+                    n.report.clone(),
+                    n.command.clone(),
+                    n.origin.clone(),
+                    n.hash.clone(),
                     r.run_id.clone().unwrap_or_default(),
                     r.warnings.to_string(),
                     r.error.clone().unwrap_or_default(),

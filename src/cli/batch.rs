@@ -9,6 +9,7 @@
 //! A subcommand joins the batch by implementing [`Task`] for its `Args` and adding one line to
 //! [`COMMANDS`].
 
+use super::out::outln;
 use super::tpms::TpmsArgs;
 use clap::{Args, FromArgMatches};
 use latvox::batch::{self, Event, Job, JobFile, Settings, Shard, Status, Task, TaskReport, Value};
@@ -97,7 +98,7 @@ impl Task for TpmsArgs {
     fn run(&self) -> Result<TaskReport> {
         let r = super::tpms::execute(self, &Progress::hidden())?;
         Ok(TaskReport {
-            passed: super::tpms::passed(&r),
+            passed: r.verdict().is_valid_solid(),
             warnings: r.warnings.clone(),
             report: serde_json::to_value(&r).map_err(|e| Error::invalid(e.to_string()))?,
         })
@@ -253,7 +254,7 @@ pub fn run(a: &BatchArgs, quiet: bool) -> Result<i32> {
                     1 => " on 1 worker".into(),
                     w => format!(" on {w} workers"),
                 };
-                println!(
+                outln!(
                     "batch {name}: {} jobs{shard_note}: {jobs} here, {skipped} already done, {to_run} to run{on}",
                     file.jobs.len(),
                 );
@@ -272,15 +273,15 @@ pub fn run(a: &BatchArgs, quiet: bool) -> Result<i32> {
                     "  {:<8}{:>8.2} s  #{:<5} {}",
                     r.status.name(),
                     r.seconds,
-                    r.job,
-                    r.output
+                    r.name.job,
+                    r.name.output
                 );
                 if let Some(e) = &r.error {
                     line.push_str(&format!(": {e}"));
                 } else if r.status == Status::Defects {
-                    line.push_str(&format!(": checks found defects (see {})", r.report));
+                    line.push_str(&format!(": checks found defects (see {})", r.name.report));
                 }
-                c.println(&line);
+                c.suspend(|| outln!("{line}"));
             }
         }
     })?;
@@ -304,13 +305,10 @@ pub fn run(a: &BatchArgs, quiet: bool) -> Result<i32> {
     summary.write_csv(&csv)?;
     summary.write_json(&json)?;
     if a.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&summary).map_err(|e| Error::invalid(e.to_string()))?
-        );
+        super::out::json(&summary);
     } else {
         let c = summary.counts;
-        println!(
+        outln!(
             "done {:.1} s: {} ok, {} skipped (done before), {} with defects, {} failed · summary {}",
             summary.seconds,
             c.ok,
@@ -324,38 +322,20 @@ pub fn run(a: &BatchArgs, quiet: bool) -> Result<i32> {
 }
 
 fn dry_run(file: &JobFile, tasks: &[&dyn Task], settings: Settings, json: bool) -> Result<i32> {
-    let mut rows = Vec::new();
-    for (job, task) in file.jobs.iter().zip(tasks) {
-        if !settings.shard.is_none_or(|s| s.contains(job.index)) {
-            continue;
-        }
-        let done = !settings.force && batch::previous_run(file, job, *task).is_some();
-        rows.push(serde_json::json!({
-            "job": job.index + 1,
-            "origin": job.origin,
-            "command": job.command,
-            "output": job.output,
-            "report": job.report,
-            "hash": job.hash,
-            "done": done,
-            "options": job.options_json(),
-        }));
-        if !json {
-            println!(
+    let jobs = batch::plan(file, tasks, settings);
+    if json {
+        super::out::json(&jobs);
+    } else {
+        for j in &jobs {
+            outln!(
                 "#{:<5} {:<9} {} {}  ({})",
-                job.index + 1,
-                if done { "done" } else { "to run" },
-                job.command,
-                job.output,
-                job.origin
+                j.name.job,
+                if j.done { "done" } else { "to run" },
+                j.name.command,
+                j.name.output,
+                j.name.origin
             );
         }
-    }
-    if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&rows).map_err(|e| Error::invalid(e.to_string()))?
-        );
     }
     Ok(0)
 }

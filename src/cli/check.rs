@@ -1,12 +1,13 @@
 //! `latvox check`: every defect of a mesh file counted (latvox's own topology and CGAL's
 //! verdict), as a summary or as JSON.
 
-use super::yes;
+use super::cgal_findings;
+use super::out::outln;
 use clap::Args;
-use latvox::check::{CheckOptions, CheckReport, Orientation};
-use latvox::io::{Loaded, ReadOptions};
+use latvox::check::{check_file, CheckOptions, CheckReport, Orientation};
+use latvox::io::{Format, Reading};
 use latvox::Result;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 pub(crate) const EXAMPLES: &str = "\
 Examples:
@@ -49,9 +50,14 @@ pub struct CheckFlags {
     pub no_self_intersection: bool,
 }
 
-/// Reads a mesh file as the CLI does.
-pub(crate) fn load(path: &Path, weld_tolerance: f64) -> Result<Loaded> {
-    latvox::io::read(path, &ReadOptions { weld_tolerance })
+impl CheckFlags {
+    /// The checks these flags ask for.
+    pub(crate) fn options(&self) -> CheckOptions {
+        CheckOptions {
+            self_intersections: !self.no_self_intersection,
+            tolerance: self.weld_tolerance,
+        }
+    }
 }
 
 pub fn run(a: &CheckArgs, quiet: bool) -> Result<i32> {
@@ -59,156 +65,82 @@ pub fn run(a: &CheckArgs, quiet: bool) -> Result<i32> {
         latvox::output::check_writable(r)?;
     }
     let progress = latvox::progress::Progress::new(quiet);
-    let loaded = {
-        let _s = progress.stage("reading");
-        load(&a.file, a.common.weld_tolerance)?
-    };
-    let mesh = &loaded.mesh;
-    let opts = CheckOptions {
-        self_intersections: !a.common.no_self_intersection,
-        tolerance: a.common.weld_tolerance,
-    };
-    // CGAL's own checks (building a mesh of its own, one facet at a time) run alongside ours.
-    let (report, cgal) = {
-        let _s = progress.stage("checking");
-        rayon::join(
-            || latvox::check::check(mesh, loaded.normals.as_deref(), &opts),
-            || latvox::verify::verify(mesh, false),
-        )
-    };
-    let (report, mut cgal) = (report?, cgal?);
-    // The check above already ran CGAL's self-intersection test (on the facets that are neither
-    // degenerate nor duplicate); it is not run twice.
-    cgal.self_intersection_checked = report.self_intersections.is_some();
-    cgal.self_intersecting = report.self_intersections.unwrap_or(0) > 0;
-    // The edge counts of the first `check` (kept for scripts that read them).
-    let edges = latvox::mesh::EdgeStats {
-        edges: report.edges,
-        boundary: report.boundary_edges,
-        non_manifold: report.non_manifold_edges,
-        misoriented: report.inconsistent_edges,
-    };
-    let ok = report.valid_solid
-        && cgal.manifold
-        && cgal.closed
-        && cgal.outward
-        && !cgal.self_intersecting;
-    let v = serde_json::json!({
-        "file": a.file.display().to_string(),
-        "format": loaded.format,
-        "valid_solid": ok,
-        "triangles": mesh.triangle_count(),
-        "vertices": mesh.vertex_count(),
-        "edges": edges,
-        "reading": reading_json(&loaded),
-        "check": report,
-        "defects": defects_json(&report),
-        "cgal": cgal,
-    });
-    if !super::emit_json(a.common.report.as_deref(), a.common.json, &v)? {
-        print_header(&a.file, &loaded);
-        print_summary(&report);
-        println!(
-            "CGAL      closed {}  outward {}  manifold {}  self-intersections {}",
-            yes(cgal.closed),
-            yes(cgal.outward),
-            yes(cgal.manifold),
-            if !cgal.self_intersection_checked {
-                "not checked"
-            } else if cgal.self_intersecting {
-                "FOUND"
-            } else {
-                "none"
-            },
-        );
-        println!(
+    let r = check_file(&a.file, &a.common.options(), &progress)?;
+    if !super::emit_json(a.common.report.as_deref(), a.common.json, &r)? {
+        print_header(&r.file, r.format, r.triangles, &r.reading);
+        print_summary(&r.check);
+        outln!("CGAL      {}", cgal_findings(&r.cgal));
+        outln!(
             "verdict   {}",
-            if ok {
+            if r.verdict.is_valid_solid() {
                 "valid closed solid"
             } else {
                 "DEFECTS FOUND (latvox repair can fix most)"
             }
         );
     }
-    Ok(if ok { 0 } else { 1 })
-}
-
-pub(crate) fn reading_json(l: &Loaded) -> serde_json::Value {
-    serde_json::json!({
-        "faces_with_fewer_than_3_corners_skipped": l.short_faces,
-        "polygons_split_into_triangles": l.polygons_split,
-        "vertices_merged_by_tolerance": l.tolerance_welded,
-    })
-}
-
-pub(crate) fn defects_json(r: &CheckReport) -> serde_json::Value {
-    r.defects()
-        .into_iter()
-        .map(|(k, n)| (k.to_string(), serde_json::json!(n)))
-        .collect::<serde_json::Map<_, _>>()
-        .into()
+    Ok(r.verdict.exit_code())
 }
 
 /// The file line of a summary, and what reading did.
-pub(crate) fn print_header(path: &Path, l: &Loaded) {
-    println!(
-        "{} ({}, {} facets read)",
-        path.display(),
-        l.format.name(),
-        l.mesh.triangle_count()
-    );
+pub(crate) fn print_header(file: &str, format: Format, facets: u64, r: &Reading) {
+    outln!("{file} ({}, {facets} facets read)", format.name());
     let mut notes = Vec::new();
-    if l.polygons_split > 0 {
+    if r.polygons_split_into_triangles > 0 {
         notes.push(format!(
             "{} polygons split into triangles",
-            l.polygons_split
+            r.polygons_split_into_triangles
         ));
     }
-    if l.short_faces > 0 {
+    if r.faces_with_fewer_than_3_corners_skipped > 0 {
         notes.push(format!(
             "{} faces with fewer than 3 corners skipped",
-            l.short_faces
+            r.faces_with_fewer_than_3_corners_skipped
         ));
     }
-    if l.tolerance_welded > 0 {
+    if r.vertices_merged_by_tolerance > 0 {
         notes.push(format!(
             "{} vertices merged by tolerance",
-            l.tolerance_welded
+            r.vertices_merged_by_tolerance
         ));
     }
     if !notes.is_empty() {
-        println!("reading   {}", notes.join(", "));
+        outln!("reading   {}", notes.join(", "));
     }
 }
 
 /// The human-readable summary of a check.
 pub(crate) fn print_summary(r: &CheckReport) {
-    println!(
+    outln!(
         "mesh      facets {}  vertices {}  edges {}  shells {}",
-        r.facets, r.vertices, r.edges, r.shell_count
+        r.facets,
+        r.vertices,
+        r.edges,
+        r.shell_count
     );
-    println!(
+    outln!(
         "measures  volume {:.4} mm³  area {:.4} mm²",
-        r.volume, r.area
+        r.volume,
+        r.area
     );
     let d = r.defects();
     if d.is_empty() {
-        println!("defects   none");
+        outln!("defects   none");
     } else {
         for (k, n) in &d {
-            println!("defect    {n} {k}");
+            outln!("defect    {n} {k}");
         }
     }
     if let Some(n) = r.normals {
         if n.unset > 0 {
-            println!(
+            outln!(
                 "note      {} stored normals are unset (zero or not finite)",
                 n.unset
             );
         }
     }
     if r.self_intersections.is_none() {
-        println!("note      self-intersections not checked");
+        outln!("note      self-intersections not checked");
     }
     const SHOWN: usize = 12;
     for (i, s) in r.shells.iter().enumerate().take(SHOWN) {
@@ -222,7 +154,7 @@ pub(crate) fn print_summary(r: &CheckReport) {
             .genus
             .map(|g| format!("genus {g}"))
             .unwrap_or_else(|| "genus -".into());
-        println!(
+        outln!(
             "shell {:<3} F {} V {} E {}  χ {}  {genus}  {}  {orient}  volume {:.4} mm³  area {:.4} mm²{}",
             i + 1,
             s.facets,
@@ -243,7 +175,7 @@ pub(crate) fn print_summary(r: &CheckReport) {
         );
     }
     if r.shells.len() > SHOWN {
-        println!(
+        outln!(
             "…         {} more shells (see --json)",
             r.shells.len() - SHOWN
         );

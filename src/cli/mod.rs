@@ -3,6 +3,7 @@
 
 pub mod batch;
 pub mod check;
+pub(crate) mod out;
 pub mod repair;
 pub mod topo;
 pub mod topopt;
@@ -132,18 +133,32 @@ pub(crate) fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<
 pub(crate) fn emit_json(
     report: Option<&Path>,
     json: bool,
-    value: &serde_json::Value,
+    value: &impl serde::Serialize,
 ) -> Result<bool> {
     if let Some(r) = report {
         write_json(r, value)?;
     }
     if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(value).expect("JSON of plain values")
-        );
+        out::json(value);
     }
     Ok(json)
+}
+
+/// CGAL's findings, as the summaries print them.
+pub(crate) fn cgal_findings(c: &latvox::verify::Verification) -> String {
+    format!(
+        "closed {}  outward {}  manifold {}  self-intersections {}",
+        yes(c.closed),
+        yes(c.outward),
+        yes(c.manifold),
+        if !c.self_intersection_checked {
+            "not checked"
+        } else if c.self_intersecting {
+            "FOUND"
+        } else {
+            "none"
+        }
+    )
 }
 
 pub(crate) fn yes(b: bool) -> &'static str {

@@ -1,10 +1,11 @@
 //! `latvox repair`: mends a mesh file and reports every change by kind and count, with the check
 //! before and after.
 
-use super::check::{defects_json, load, print_header, print_summary, reading_json};
+use super::check::{print_header, print_summary};
+use super::out::outln;
 use clap::Args;
-use latvox::check::CheckOptions;
-use latvox::repair::RepairOptions;
+use latvox::repair::{repair_file, RepairOptions};
+use latvox::sink::MeshFile;
 use latvox::Result;
 use std::path::PathBuf;
 
@@ -59,104 +60,46 @@ pub struct RepairArgs {
 
 pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
     latvox::output::check_writable(&a.output)?;
-    if latvox::io::Format::from_path(&a.output).is_none() {
-        return Err(latvox::Error::invalid(format!(
-            "{}: unknown mesh extension (use .stl, .obj, .off, .ply or .3mf)",
-            a.output.display()
-        )));
-    }
+    let output = MeshFile::new(&a.output, a.ascii)?;
     if let Some(r) = &a.common.report {
         latvox::output::check_writable(r)?;
     }
-    let progress = latvox::progress::Progress::new(quiet);
-    let loaded = {
-        let _s = progress.stage("reading");
-        load(&a.input, a.common.weld_tolerance)?
-    };
-    let copts = CheckOptions {
-        self_intersections: !a.common.no_self_intersection,
-        tolerance: a.common.weld_tolerance,
-    };
-    // CGAL's self-intersection test (the costliest check) runs once, on the result: repair does
-    // not mend self-intersections, so the count before would only repeat it.
-    let before = {
-        let _s = progress.stage("checking the input");
-        let opts = CheckOptions {
-            self_intersections: false,
-            ..copts
-        };
-        latvox::check::check(&loaded.mesh, loaded.normals.as_deref(), &opts)?
-    };
-    let ropts = RepairOptions {
+    let opts = RepairOptions {
         fill_holes: !a.no_fill,
         fair: !a.no_fair,
         stitch_tolerance: a.stitch_tolerance,
         drop_open_shells: a.drop_open_shells,
         remesh: a.remesh,
     };
-    let (mesh, changes) = latvox::repair::repair(&loaded.mesh, &ropts, &progress)?;
-    if mesh.triangle_count() == 0 {
-        return Err(latvox::Error::invalid(format!(
-            "{}: nothing is left after repair (every facet was degenerate{}); no file written",
-            a.input.display(),
-            if a.drop_open_shells {
-                " or in an open shell"
-            } else {
-                ""
-            }
-        )));
-    }
-    {
-        let _s = progress.stage("writing");
-        latvox::io::save(&mesh, &a.output, a.ascii)?;
-    }
-    // The verdict is on the file as written and read back, as the next program will see it
-    // (STL, for one, welds vertices by position).
-    let after = {
-        let _s = progress.stage("checking the written file");
-        let written = load(&a.output, 0.0)?;
-        latvox::check::check(&written.mesh, written.normals.as_deref(), &copts)?
-    };
-    let normals_fixed = before
-        .normals
-        .map(|n| n.reversed + n.inaccurate + n.unset)
-        .unwrap_or(0);
-    let v = serde_json::json!({
-        "input": a.input.display().to_string(),
-        "output": a.output.display().to_string(),
-        "format": loaded.format,
-        "reading": reading_json(&loaded),
-        "before": before,
-        "defects_before": defects_json(&before),
-        "repair": changes,
-        "normals_recomputed": normals_fixed,
-        "after": after,
-        "defects_after": defects_json(&after),
-        "valid_solid": after.valid_solid,
-    });
-    if !super::emit_json(a.common.report.as_deref(), a.common.json, &v)? {
-        print_header(&a.input, &loaded);
-        let d = before.defects();
+    let progress = latvox::progress::Progress::new(quiet);
+    let r = repair_file(&a.input, &output, &a.common.options(), &opts, &progress)?;
+    if !super::emit_json(a.common.report.as_deref(), a.common.json, &r)? {
+        print_header(&r.input, r.format, r.before.facets, &r.reading);
+        let d = &r.defects_before.0;
         if d.is_empty() {
-            println!("before    no defects (self-intersections are checked on the result)");
+            outln!("before    no defects (self-intersections are checked on the result)");
         } else {
             let list: Vec<String> = d.iter().map(|(k, n)| format!("{n} {k}")).collect();
-            println!(
+            outln!(
                 "before    {} (self-intersections are checked on the result)",
                 list.join(", ")
             );
         }
-        if changes.changes.is_empty() && normals_fixed == 0 {
-            println!("changes   none (the mesh is written unchanged)");
+        let changes = &r.repair;
+        if changes.changes.is_empty() && r.normals_recomputed == 0 {
+            outln!("changes   none (the mesh is written unchanged)");
         }
         for c in &changes.changes {
-            println!("changed   {} {}", c.count, c.kind);
+            outln!("changed   {} {}", c.count, c.kind);
         }
-        if normals_fixed > 0 {
-            println!("changed   {normals_fixed} stored normals recomputed from the winding");
+        if r.normals_recomputed > 0 {
+            outln!(
+                "changed   {} stored normals recomputed from the winding",
+                r.normals_recomputed
+            );
         }
         for s in &changes.open_shells {
-            println!(
+            outln!(
                 "open      a shell of {} facets still has {} boundary edges ({} hole loops){}",
                 s.facets,
                 s.boundary_edges,
@@ -169,24 +112,24 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
             );
         }
         if changes.non_orientable_shells > 0 {
-            println!(
+            outln!(
                 "open      {} shell(s) cannot be wound consistently (one-sided)",
                 changes.non_orientable_shells
             );
         }
-        println!("after ({})", a.output.display());
-        print_summary(&after);
-        if after.self_intersections.unwrap_or(0) > 0 && a.remesh.is_none() {
-            println!("hint      self-intersections remain: --remesh VOXEL rebuilds the part without them");
+        outln!("after ({})", r.output);
+        print_summary(&r.after);
+        if r.verdict.self_intersecting && a.remesh.is_none() {
+            outln!("hint      self-intersections remain: --remesh VOXEL rebuilds the part without them");
         }
-        println!(
+        outln!(
             "verdict   {}",
-            if after.valid_solid {
+            if r.verdict.is_valid_solid() {
                 "valid closed solid"
             } else {
                 "DEFECTS REMAIN"
             }
         );
     }
-    Ok(if after.valid_solid { 0 } else { 1 })
+    Ok(r.verdict.exit_code())
 }

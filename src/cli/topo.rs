@@ -1,8 +1,9 @@
 //! `latvox topo`: a density field to a printable STL and parametric CAD (seed 003).
 
-use super::{write_json, yes};
+use super::out::outln;
+use super::{cgal_findings, write_json};
 use clap::Args;
-use latvox::io::stl::StlFormat;
+use latvox::sink::MeshFile;
 use latvox::topo::job::{self, TopoJob};
 use latvox::topo::volume::Smoothing;
 use latvox::topo::{CleanOptions, Density};
@@ -74,10 +75,10 @@ pub struct TopoArgs {
     /// Max deviation of the CAD curves from the boundary, mm (default: half a refined pixel).
     #[arg(long, value_name = "MM")]
     pub tolerance: Option<f64>,
-    /// Output STL.
+    /// Output mesh, in the format its extension names: .stl, .obj, .off, .ply or .3mf.
     #[arg(long, short = 'o', value_name = "FILE.stl", default_value = "part.stl")]
     pub output: PathBuf,
-    /// Write ASCII STL.
+    /// Write ASCII STL (or ASCII PLY).
     #[arg(long)]
     pub ascii: bool,
     /// IGES file of the adaptive B-spline curves (2D).
@@ -175,14 +176,10 @@ pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
     for f in outputs.into_iter().flatten() {
         latvox::output::check_writable(f)?;
     }
+    let output = MeshFile::new(&a.output, a.ascii)?;
     let progress = latvox::progress::Progress::new(quiet);
     let r = job::run(&d, &job, &progress)?;
-    let format = if a.ascii {
-        StlFormat::Ascii
-    } else {
-        StlFormat::Binary
-    };
-    latvox::io::stl::save(&r.mesh, format, &a.output)?;
+    output.save(&r.mesh)?;
     let stamp = timestamp();
     let name = |p: &PathBuf| {
         p.file_name()
@@ -255,11 +252,12 @@ pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
             100.0 * r.report.measure_change
         );
     }
-    let valid = r.report.checks.closed
-        && r.report.checks.outward
-        && r.report.checks.manifold
-        && !r.report.checks.self_intersecting;
-    Ok(if r.report.clean && valid { 0 } else { 1 })
+    // Features the printer cannot make that remain after the last pass are defects too.
+    Ok(if r.report.clean {
+        r.report.checks.verdict().exit_code()
+    } else {
+        1
+    })
 }
 
 fn timestamp() -> String {
@@ -292,15 +290,19 @@ fn summary(r: &job::TopoReport, a: &TopoArgs, images: &[PathBuf]) {
     } else {
         format!("{}×{}", r.dims[0], r.dims[1])
     };
-    println!(
+    outln!(
         "input     {dims} elements of {} mm, refined ×{} to {} mm pixels",
-        r.element_size, r.job.clean.refine, r.pixel_size
+        r.element_size,
+        r.job.clean.refine,
+        r.pixel_size
     );
-    println!(
+    outln!(
         "initial   thin-feature pixels {}, islands {}, point contacts {}",
-        r.initial.thin_pixels, r.initial.islands, r.initial.point_contacts
+        r.initial.thin_pixels,
+        r.initial.islands,
+        r.initial.point_contacts
     );
-    println!(
+    outln!(
         "cleaned   {} after {} pass(es): thin {}, islands {}, contacts {} (level {:.4})",
         if r.clean { "clean" } else { "NOT CLEAN" },
         r.iterations,
@@ -310,29 +312,19 @@ fn summary(r: &job::TopoReport, a: &TopoArgs, images: &[PathBuf]) {
         r.level
     );
     let unit = if r.is_3d { "mm³" } else { "mm²" };
-    println!(
+    outln!(
         "volume    thresholded {:.3} {unit}, final {:.3} {unit} ({:+.3} %)",
         r.thresholded_measure,
         r.final_measure,
         100.0 * r.measure_change
     );
-    let c = &r.checks;
-    println!(
-        "mesh      {} triangles; CGAL closed {}  outward {}  manifold {}  self-intersections {}",
+    outln!(
+        "mesh      {} triangles; CGAL {}",
         r.triangles,
-        yes(c.closed),
-        yes(c.outward),
-        yes(c.manifold),
-        if !c.self_intersection_checked {
-            "not checked"
-        } else if c.self_intersecting {
-            "FOUND"
-        } else {
-            "none"
-        }
+        cgal_findings(&r.checks)
     );
     if !r.loops.is_empty() {
-        println!(
+        outln!(
             "curves    {} loop(s): uniform {} control points, adaptive {} ({:.0} %), tolerance {} mm",
             r.loops.len(),
             r.uniform_control_points,
@@ -341,15 +333,15 @@ fn summary(r: &job::TopoReport, a: &TopoArgs, images: &[PathBuf]) {
             r.job.tolerance
         );
     }
-    println!("time      {:.3} s", r.timings.total);
-    println!("wrote     {}", a.output.display());
+    outln!("time      {:.3} s", r.timings.total);
+    outln!("wrote     {}", a.output.display());
     for p in [&a.iges, &a.dxf, &a.report, &a.cleaned]
         .into_iter()
         .flatten()
     {
-        println!("wrote     {}", p.display());
+        outln!("wrote     {}", p.display());
     }
     for p in images {
-        println!("wrote     {}", p.display());
+        outln!("wrote     {}", p.display());
     }
 }

@@ -1,6 +1,7 @@
 //! `latvox topopt`: SIMP minimum-compliance optimisation; writes the densities (.npy), the
 //! per-iteration log and a JSON report.
 
+use super::out::outln;
 use super::write_json;
 use clap::{Args, ValueEnum};
 use latvox::topopt::{self, FilterKind, Settings};
@@ -161,7 +162,7 @@ pub fn run(a: &TopoptArgs, quiet: bool) -> Result<i32> {
     let verbose = !quiet;
     let r = topopt::optimise(&p, &s, &progress, |i, c, v, ch| {
         if verbose {
-            println!(" It.:{i:5} Obj.:{c:11.4} Vol.:{v:7.3} ch.:{ch:7.3}");
+            outln!(" It.:{i:5} Obj.:{c:11.4} Vol.:{v:7.3} ch.:{ch:7.3}");
         }
     })?;
     let (shape, data) = topopt::to_array(&p, &r.densities);
@@ -198,7 +199,7 @@ pub fn run(a: &TopoptArgs, quiet: bool) -> Result<i32> {
     if let Some(f) = &a.report {
         write_json(f, &report)?;
     }
-    println!(
+    outln!(
         "{} {}×{}{}: compliance {:.4} after {} iterations ({}), volume {:.4}, {:.2} s",
         p.name,
         p.nelx,
@@ -218,6 +219,6 @@ pub fn run(a: &TopoptArgs, quiet: bool) -> Result<i32> {
         r.volume.last().unwrap_or(&f64::NAN),
         report.time_s
     );
-    println!("wrote     {}", a.output.display());
+    outln!("wrote     {}", a.output.display());
     Ok(0)
 }

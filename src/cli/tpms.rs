@@ -1,11 +1,12 @@
 //! `latvox tpms`: a closed TPMS lattice at an exact volume fraction.
 
+use super::out::outln;
 use super::{
-    parse_counts, parse_density, parse_finite3, parse_positive3, parse_size, parse_tile,
-    parse_unit, write_json, yes,
+    cgal_findings, parse_counts, parse_density, parse_finite3, parse_positive3, parse_size,
+    parse_tile, parse_unit, write_json,
 };
 use clap::Args;
-use latvox::io::stl::StlFormat;
+use latvox::sink::MeshFile;
 use latvox::tpms::{Domain, Structure, Surface, TpmsJob, TpmsReport};
 use latvox::{Error, Result};
 use std::path::PathBuf;
@@ -67,16 +68,17 @@ pub struct TpmsArgs {
     /// OpenVDB mesh adaptivity: 0 keeps uniform triangles, up to 1 merges flat regions.
     #[arg(long, default_value_t = 0.0, value_parser = parse_unit)]
     pub adaptivity: f64,
-    /// Output mesh: binary STL (ASCII with --ascii), or a 3MF package when the name ends in
-    /// .3mf; streamed to the file as it is made.
+    /// Output mesh, in the format its extension names: .stl (binary, ASCII with --ascii) or
+    /// .3mf, streamed to the file as it is made; .obj, .off or .ply (binary, ASCII with
+    /// --ascii), written once the part is whole.
     #[arg(
         long,
         short = 'o',
-        value_name = "FILE.stl|FILE.3mf",
+        value_name = "FILE.stl|.3mf|.obj|.off|.ply",
         default_value = "lattice.stl"
     )]
     pub output: PathBuf,
-    /// Write ASCII STL instead of binary.
+    /// Write ASCII STL (or ASCII PLY) instead of binary.
     #[arg(long)]
     pub ascii: bool,
     /// Write a JSON report (type, level, densities, mesh counts, CGAL checks, timings).
@@ -151,7 +153,7 @@ pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
         eprintln!("latvox: warning: {w}");
     }
     print_tpms_summary(&report);
-    Ok(if passed(&report) { 0 } else { 1 })
+    Ok(report.verdict().exit_code())
 }
 
 /// Runs the job and writes its mesh atomically; returns the report (output and write time
@@ -173,26 +175,12 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
         keep_fragments: a.keep_fragments,
     };
     latvox::output::check_writable(&a.output)?;
-    let format = if a.ascii {
-        StlFormat::Ascii
-    } else {
-        StlFormat::Binary
-    };
-    // The part streams into a temporary file that becomes the output only once the job is done.
-    let mut sink = latvox::sink::FileSink::create(&a.output, format)?;
+    // The part goes to a temporary file that becomes the output only once the job is done.
+    let mut sink = MeshFile::new(&a.output, a.ascii)?.sink()?;
     let mut report = job.run_into(progress, &mut sink)?;
     sink.commit()?;
     report.output = Some(a.output.display().to_string());
     Ok(report)
-}
-
-/// Whether the part passed: CGAL's checks (those that were asked for), the density, and one
-/// piece (unless fragments were kept on purpose).
-pub fn passed(r: &TpmsReport) -> bool {
-    let solid = r.checks.is_valid_solid()
-        || !r.checks.self_intersection_checked && r.checks.closed && r.checks.outward;
-    let one_piece = r.one_piece != Some(false) || !r.fragments.removed && r.fragments.count > 0;
-    solid && r.density_met && one_piece
 }
 
 /// A number for people: at most `digits` decimals, trailing zeros dropped.
@@ -206,7 +194,6 @@ fn human(x: f64, digits: usize) -> String {
 }
 
 fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
-    let c = &r.checks;
     let triple = |v: [f64; 3]| {
         if v[0] == v[1] && v[1] == v[2] {
             human(v[0], 3)
@@ -215,7 +202,7 @@ fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
         }
     };
     let cells = r.cells.map(|x| human(x, 2)).join("×");
-    println!(
+    outln!(
         "{} {} · {cells} cells of {} mm · {} voxels/cell ({} mm)",
         r.surface.name(),
         r.structure.name(),
@@ -223,11 +210,14 @@ fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
         r.resolution,
         human(r.voxel_size, 4)
     );
-    println!(
+    outln!(
         "density   target {:.4}  achieved {:.4}  (error {:+.5}, level t = {:.5})",
-        r.target_density, r.achieved_density, r.density_error, r.level
+        r.target_density,
+        r.achieved_density,
+        r.density_error,
+        r.level
     );
-    println!(
+    outln!(
         "mesh      {} triangles, {} vertices, area {:.2} mm², volume {:.2} mm³",
         r.triangles,
         r.vertices,
@@ -235,13 +225,18 @@ fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
         r.volume.unwrap_or(f64::NAN)
     );
     if let Some(b) = r.bounding_box {
-        println!(
+        outln!(
             "bounds    [{:.3}, {:.3}, {:.3}] – [{:.3}, {:.3}, {:.3}] mm",
-            b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]
+            b.min[0],
+            b.min[1],
+            b.min[2],
+            b.max[0],
+            b.max[1],
+            b.max[2]
         );
     }
     let f = &r.fragments;
-    println!(
+    outln!(
         "pieces    {}",
         match r.one_piece {
             None => "not checked (meshed in tiles without a template of its cells)".to_string(),
@@ -261,25 +256,13 @@ fn print_tpms_summary(r: &latvox::tpms::TpmsReport) {
             ),
         }
     );
-    println!(
-        "CGAL      closed {}  outward {}  manifold {}  self-intersections {}",
-        yes(c.closed),
-        yes(c.outward),
-        yes(c.manifold),
-        if !c.self_intersection_checked {
-            "not checked"
-        } else if c.self_intersecting {
-            "FOUND"
-        } else {
-            "none"
-        }
-    );
+    outln!("CGAL      {}", cgal_findings(&r.checks));
     let t = &r.timings;
-    println!(
+    outln!(
         "time      {:.3} s (calibrate {:.3}, sample {:.3}, mesh {:.3}, snap {:.3}, verify {:.3}, write {:.3})",
         t.total, t.calibrate, t.sample, t.mesh, t.snap, t.verify, t.write
     );
     if let Some(o) = &r.output {
-        println!("wrote     {o}");
+        outln!("wrote     {o}");
     }
 }

@@ -110,8 +110,27 @@ pub struct Loaded {
     pub tolerance_welded: u64,
 }
 
+impl Loaded {
+    /// What reading did to the file.
+    pub fn reading(&self) -> Reading {
+        Reading {
+            faces_with_fewer_than_3_corners_skipped: self.short_faces,
+            polygons_split_into_triangles: self.polygons_split,
+            vertices_merged_by_tolerance: self.tolerance_welded,
+        }
+    }
+}
+
+/// What reading a file did to it, as reports give it (all zero for a clean file).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Reading {
+    pub faces_with_fewer_than_3_corners_skipped: u64,
+    pub polygons_split_into_triangles: u64,
+    pub vertices_merged_by_tolerance: u64,
+}
+
 /// Parses `data` as `format`.
-pub fn parse(data: &[u8], format: Format) -> std::result::Result<Parsed, String> {
+pub fn parse(data: &[u8], format: Format) -> Result<Parsed> {
     match format {
         Format::Stl => stl::parse_facets(data),
         Format::Obj => obj::parse(data),
@@ -130,10 +149,8 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded> {
     }
     let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let format = Format::from_path(path).unwrap_or_else(|| Format::sniff(&data));
-    let p = parse(&data, format).map_err(|message| Error::Format {
-        path: path.to_path_buf(),
-        message: format!("{}: {message}", format.name()),
-    })?;
+    let p = parse(&data, format)
+        .map_err(|e| Error::parse(format!("{}: {e}", format.name())).in_file(path))?;
     drop(data);
     let mut mesh = p.mesh;
     let tolerance_welded = weld::weld_tolerance(&mut mesh, opts.weld_tolerance);
@@ -171,17 +188,6 @@ pub fn write(
     }
 }
 
-/// Writes `mesh` to `path` atomically, in the format its extension names.
-pub fn save(mesh: &Mesh, path: &Path, ascii: bool) -> Result<()> {
-    let format = Format::from_path(path).ok_or_else(|| {
-        Error::invalid(format!(
-            "{}: unknown mesh extension (use .stl, .obj, .off, .ply or .3mf)",
-            path.display()
-        ))
-    })?;
-    crate::output::write_atomic(path, |w| write(mesh, format, ascii, w))
-}
-
 /// Collects polygons from an indexed-format reader and turns them into a welded triangle mesh.
 pub(crate) struct PolygonSink {
     pub positions: Vec<f32>,
@@ -206,15 +212,15 @@ impl PolygonSink {
         self.positions.len() / 3
     }
 
-    pub fn push_vertex(&mut self, p: [f32; 3]) -> std::result::Result<(), String> {
+    pub fn push_vertex(&mut self, p: [f32; 3]) -> Result<()> {
         if !p.iter().all(|v| v.is_finite()) {
-            return Err(format!(
+            return Err(Error::parse(format!(
                 "vertex {}: non-finite coordinate {p:?}",
                 self.vertex_count() + 1
-            ));
+            )));
         }
         if self.vertex_count() >= u32::MAX as usize {
-            return Err("more than 2^32 vertices".into());
+            return Err(Error::parse("more than 2^32 vertices"));
         }
         self.positions.extend_from_slice(&p);
         Ok(())
@@ -226,10 +232,12 @@ impl PolygonSink {
     }
 
     /// Closes the current face; its indices must name vertices already read.
-    pub fn end_face(&mut self) -> std::result::Result<(), String> {
+    pub fn end_face(&mut self) -> Result<()> {
         let nv = self.vertex_count();
         if let Some(&bad) = self.corners.iter().find(|&&i| i as usize >= nv) {
-            return Err(format!("face corner {bad} past the {nv} vertices"));
+            return Err(Error::parse(format!(
+                "face corner {bad} past the {nv} vertices"
+            )));
         }
         let c = std::mem::take(&mut self.corners);
         match c.len() {
@@ -264,9 +272,9 @@ impl PolygonSink {
         Ok(())
     }
 
-    pub fn finish(self) -> std::result::Result<Parsed, String> {
+    pub fn finish(self) -> Result<Parsed> {
         if self.indices.is_empty() {
-            return Err("no triangles in the file".into());
+            return Err(Error::parse("no triangles in the file"));
         }
         Ok(Parsed {
             mesh: weld::weld_indexed(&self.positions, &self.indices)?,

@@ -3,11 +3,12 @@
 //! groups, materials, lines) is ignored. Written as `v` and `f` lines, 1-based.
 
 use super::{Parsed, PolygonSink};
+use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use std::io::Write;
 
 /// Parses OBJ bytes (any line ends; non-UTF-8 bytes in ignored lines are harmless).
-pub fn parse(data: &[u8]) -> Result<Parsed, String> {
+pub fn parse(data: &[u8]) -> Result<Parsed> {
     let mut sink = PolygonSink::new();
     // Faces are kept until the end: a face may name vertices defined after it.
     let mut faces: Vec<u32> = Vec::new();
@@ -26,10 +27,10 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
                         .next()
                         .and_then(|w| std::str::from_utf8(w).ok())
                         .and_then(|s| s.parse::<f32>().ok())
-                        .ok_or_else(|| format!("line {lineno}: bad vertex"))?;
+                        .ok_or_else(|| Error::parse(format!("line {lineno}: bad vertex")))?;
                 }
                 sink.push_vertex(p)
-                    .map_err(|e| format!("line {lineno}: {e}"))?;
+                    .map_err(|e| Error::parse(format!("line {lineno}: {e}")))?;
             }
             b"f" | b"fo" => {
                 let nv = sink.vertex_count() as i64;
@@ -39,16 +40,20 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
                     let i: i64 = std::str::from_utf8(first)
                         .ok()
                         .and_then(|s| s.parse().ok())
-                        .ok_or_else(|| format!("line {lineno}: bad face index"))?;
+                        .ok_or_else(|| Error::parse(format!("line {lineno}: bad face index")))?;
                     let abs = match i {
                         0 => {
-                            return Err(format!("line {lineno}: face index 0 (OBJ counts from 1)"))
+                            return Err(Error::parse(format!(
+                                "line {lineno}: face index 0 (OBJ counts from 1)"
+                            )))
                         }
                         i if i > 0 => i - 1,
                         i => nv + i,
                     };
                     if !(0..u32::MAX as i64).contains(&abs) {
-                        return Err(format!("line {lineno}: face index {i} out of range"));
+                        return Err(Error::parse(format!(
+                            "line {lineno}: face index {i} out of range"
+                        )));
                     }
                     faces.push(abs as u32);
                     n += 1;
@@ -65,7 +70,7 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
         }
         k += n as usize;
         sink.end_face()
-            .map_err(|e| format!("face {}: {e}", f + 1))?;
+            .map_err(|e| Error::parse(format!("face {}: {e}", f + 1)))?;
     }
     sink.finish()
 }
@@ -93,7 +98,10 @@ mod tests {
         let p = parse(text).unwrap();
         assert_eq!(p.mesh.triangle_count(), 3);
         assert_eq!(p.polygons_split, 1);
-        assert!(parse(b"v 0 0 0\nf 1 2 3\n").unwrap_err().contains("past"));
+        assert!(parse(b"v 0 0 0\nf 1 2 3\n")
+            .unwrap_err()
+            .to_string()
+            .contains("past"));
         assert!(parse(b"v 0 0 0\nf 0 1 1\n").is_err());
     }
 }

@@ -4,6 +4,7 @@
 //! comment. Counts bound the loops only; a file shorter than its counts is an error.
 
 use super::{Parsed, PolygonSink};
+use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use std::io::Write;
 
@@ -29,7 +30,7 @@ fn keyword_ok(w: &[u8]) -> bool {
 }
 
 /// Parses OFF text.
-pub fn parse(data: &[u8]) -> Result<Parsed, String> {
+pub fn parse(data: &[u8]) -> Result<Parsed> {
     // Lines without comments, blank lines dropped, with their line numbers.
     let mut lines = data
         .split(|&b| b == b'\n' || b == b'\r')
@@ -48,32 +49,32 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
             .map(|w| std::str::from_utf8(w).unwrap_or("\u{fffd}").to_string())
             .collect::<Vec<String>>()
     };
-    let (_, first) = lines.next().ok_or("empty file")?;
+    let (_, first) = lines.next().ok_or_else(|| Error::parse("empty file"))?;
     let mut head = words(first);
     if !keyword_ok(head[0].as_bytes()) {
-        return Err(format!(
+        return Err(Error::parse(format!(
             "expected the OFF keyword, found '{}'",
             trunc(&head[0])
-        ));
+        )));
     }
     let four_d = head[0].contains('4');
     if head
         .get(1)
         .is_some_and(|w| w.eq_ignore_ascii_case("BINARY"))
     {
-        return Err("binary OFF is not supported".into());
+        return Err(Error::parse("binary OFF is not supported"));
     }
     head.remove(0);
     if head.is_empty() {
         let (_, l) = lines
             .next()
-            .ok_or("file ends before the vertex and face counts")?;
+            .ok_or_else(|| Error::parse("file ends before the vertex and face counts"))?;
         head = words(l);
     }
-    let count = |i: usize, what: &str| -> Result<u64, String> {
+    let count = |i: usize, what: &str| -> Result<u64> {
         head.get(i)
             .and_then(|w| w.parse::<u64>().ok())
-            .ok_or_else(|| format!("bad {what} count in the OFF header"))
+            .ok_or_else(|| Error::parse(format!("bad {what} count in the OFF header")))
     };
     let (nv, nf) = (count(0, "vertex")?, count(1, "face")?);
     let mut sink = PolygonSink::new();
@@ -82,39 +83,43 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
     for k in 0..nv {
         let (ln, l) = lines
             .next()
-            .ok_or_else(|| format!("file ends after {k} of {nv} vertices"))?;
+            .ok_or_else(|| Error::parse(format!("file ends after {k} of {nv} vertices")))?;
         let w = words(l);
-        let c = |a: usize| -> Result<f32, String> {
+        let c = |a: usize| -> Result<f32> {
             w.get(a)
                 .and_then(|s| s.parse::<f32>().ok())
-                .ok_or_else(|| format!("line {ln}: bad vertex"))
+                .ok_or_else(|| Error::parse(format!("line {ln}: bad vertex")))
         };
         let mut p = [c(0)?, c(1)?, c(2)?];
         if four_d {
             let h = c(3)?;
             p = p.map(|x| x / h);
         }
-        sink.push_vertex(p).map_err(|e| format!("line {ln}: {e}"))?;
+        sink.push_vertex(p)
+            .map_err(|e| Error::parse(format!("line {ln}: {e}")))?;
     }
     for k in 0..nf {
         let (ln, l) = lines
             .next()
-            .ok_or_else(|| format!("file ends after {k} of {nf} faces"))?;
+            .ok_or_else(|| Error::parse(format!("file ends after {k} of {nf} faces")))?;
         let w = words(l);
         let n: usize = w
             .first()
             .and_then(|s| s.parse().ok())
-            .ok_or_else(|| format!("line {ln}: bad face"))?;
+            .ok_or_else(|| Error::parse(format!("line {ln}: bad face")))?;
         if n >= w.len() {
-            return Err(format!("line {ln}: face says {n} corners but lists fewer"));
+            return Err(Error::parse(format!(
+                "line {ln}: face says {n} corners but lists fewer"
+            )));
         }
         for s in &w[1..=n] {
             let i: u32 = s
                 .parse()
-                .map_err(|_| format!("line {ln}: bad vertex index '{}'", trunc(s)))?;
+                .map_err(|_| Error::parse(format!("line {ln}: bad vertex index '{}'", trunc(s))))?;
             sink.corner(i);
         }
-        sink.end_face().map_err(|e| format!("line {ln}: {e}"))?;
+        sink.end_face()
+            .map_err(|e| Error::parse(format!("line {ln}: {e}")))?;
     }
     sink.finish()
 }
@@ -148,6 +153,7 @@ mod tests {
         assert_eq!(p.mesh.triangle_count(), 2);
         assert!(parse(b"OFF\n4000000000 1 0\n0 0 0\n")
             .unwrap_err()
+            .to_string()
             .contains("ends after 1"));
         assert!(
             parse(b"COFF\n3 1 0\n0 0 0 1 1 1 1\n1 0 0 1 1 1 1\n0 1 0 1 1 1 1\n3 0 1 5\n").is_err()

@@ -5,6 +5,7 @@
 //! Written as binary little-endian (float coordinates, uchar/uint face lists) or ASCII.
 
 use super::{Parsed, PolygonSink, Words};
+use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use std::io::Write;
 
@@ -73,23 +74,25 @@ struct Body<'a> {
 }
 
 impl Body<'_> {
-    fn value(&mut self, t: Scalar) -> Result<f64, String> {
+    fn value(&mut self, t: Scalar) -> Result<f64> {
         if self.enc == Encoding::Ascii {
             let mut w = Words::new(self.data);
             w.pos = self.pos;
-            let tok = w.next().ok_or("file ends inside the data")?;
+            let tok = w
+                .next()
+                .ok_or_else(|| Error::parse("file ends inside the data"))?;
             let start = self.pos;
             self.pos = w.pos;
             return std::str::from_utf8(tok)
                 .ok()
                 .and_then(|s| s.parse::<f64>().ok())
-                .ok_or_else(|| format!("bad number at byte {start}"));
+                .ok_or_else(|| Error::parse(format!("bad number at byte {start}")));
         }
         let n = t.size();
         let b = self
             .data
             .get(self.pos..self.pos + n)
-            .ok_or("file ends inside the data")?;
+            .ok_or_else(|| Error::parse("file ends inside the data"))?;
         self.pos += n;
         let mut a = [0u8; 8];
         a[..n].copy_from_slice(b);
@@ -113,7 +116,7 @@ impl Body<'_> {
     }
 }
 
-fn header(data: &[u8]) -> Result<(Encoding, Vec<Element>, usize), String> {
+fn header(data: &[u8]) -> Result<(Encoding, Vec<Element>, usize)> {
     let mut pos = 0usize;
     let mut elements: Vec<Element> = Vec::new();
     let mut enc = None;
@@ -123,8 +126,9 @@ fn header(data: &[u8]) -> Result<(Encoding, Vec<Element>, usize), String> {
         let end = rest
             .iter()
             .position(|&b| b == b'\n' || b == b'\r')
-            .ok_or("header has no end_header line")?;
-        let line = std::str::from_utf8(&rest[..end]).map_err(|_| "non-text bytes in the header")?;
+            .ok_or_else(|| Error::parse("header has no end_header line"))?;
+        let line = std::str::from_utf8(&rest[..end])
+            .map_err(|_| Error::parse("non-text bytes in the header"))?;
         pos += end + 1;
         if rest[end] == b'\r' && data.get(pos) == Some(&b'\n') {
             pos += 1;
@@ -132,7 +136,7 @@ fn header(data: &[u8]) -> Result<(Encoding, Vec<Element>, usize), String> {
         let w: Vec<&str> = line.split_whitespace().collect();
         if first {
             if w.first() != Some(&"ply") {
-                return Err("does not start with 'ply'".into());
+                return Err(Error::parse("does not start with 'ply'"));
             }
             first = false;
             continue;
@@ -144,43 +148,52 @@ fn header(data: &[u8]) -> Result<(Encoding, Vec<Element>, usize), String> {
                     "ascii" => Encoding::Ascii,
                     "binary_little_endian" => Encoding::Little,
                     "binary_big_endian" => Encoding::Big,
-                    _ => return Err(format!("unknown format '{f}'")),
+                    _ => return Err(Error::parse(format!("unknown format '{f}'"))),
                 })
             }
             ["element", name, n] => elements.push(Element {
                 name: name.to_string(),
                 count: n
                     .parse()
-                    .map_err(|_| format!("bad count for element {name}"))?,
+                    .map_err(|_| Error::parse(format!("bad count for element {name}")))?,
                 props: Vec::new(),
             }),
             ["property", "list", c, i, name] => {
-                let el = elements.last_mut().ok_or("property before any element")?;
+                let el = elements
+                    .last_mut()
+                    .ok_or_else(|| Error::parse("property before any element"))?;
                 let (c, i) = (
-                    Scalar::parse(c).ok_or_else(|| format!("unknown type '{c}'"))?,
-                    Scalar::parse(i).ok_or_else(|| format!("unknown type '{i}'"))?,
+                    Scalar::parse(c).ok_or_else(|| Error::parse(format!("unknown type '{c}'")))?,
+                    Scalar::parse(i).ok_or_else(|| Error::parse(format!("unknown type '{i}'")))?,
                 );
                 el.props.push(Prop::List(name.to_string(), c, i));
             }
             ["property", t, name] => {
-                let el = elements.last_mut().ok_or("property before any element")?;
-                let t = Scalar::parse(t).ok_or_else(|| format!("unknown type '{t}'"))?;
+                let el = elements
+                    .last_mut()
+                    .ok_or_else(|| Error::parse("property before any element"))?;
+                let t =
+                    Scalar::parse(t).ok_or_else(|| Error::parse(format!("unknown type '{t}'")))?;
                 el.props.push(Prop::Scalar(name.to_string(), t));
             }
             ["end_header"] => break,
             _ => {
-                return Err(format!(
+                return Err(Error::parse(format!(
                     "unexpected header line '{}'",
                     line.chars().take(40).collect::<String>()
-                ))
+                )))
             }
         }
     }
-    Ok((enc.ok_or("no format line")?, elements, pos))
+    Ok((
+        enc.ok_or_else(|| Error::parse("no format line"))?,
+        elements,
+        pos,
+    ))
 }
 
 /// Parses PLY bytes.
-pub fn parse(data: &[u8]) -> Result<Parsed, String> {
+pub fn parse(data: &[u8]) -> Result<Parsed> {
     let (enc, elements, start) = header(data)?;
     let mut body = Body {
         data,
@@ -201,13 +214,16 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
             .sum::<usize>()
             .max(1);
         if el.count > 0 && el.props.is_empty() {
-            return Err(format!("element {} has no properties", el.name));
+            return Err(Error::parse(format!(
+                "element {} has no properties",
+                el.name
+            )));
         }
         if el.count > (body.left() / min_size) as u64 {
-            return Err(format!(
+            return Err(Error::parse(format!(
                 "element {} says {} items but the file is too short",
                 el.name, el.count
-            ));
+            )));
         }
         let is_vertex = el.name == "vertex";
         let is_face = el.name == "face";
@@ -228,10 +244,10 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
         }
         if is_vertex {
             if ix.is_none() || iy.is_none() || iz.is_none() {
-                return Err("vertex element without x, y, z".into());
+                return Err(Error::parse("vertex element without x, y, z"));
             }
             if is_face || saw_vertex {
-                return Err("more than one vertex element".into());
+                return Err(Error::parse("more than one vertex element"));
             }
             saw_vertex = true;
             sink.positions.reserve(3 * el.count as usize);
@@ -253,28 +269,34 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
                     Prop::List(_, c, t) => {
                         let n = body.value(*c)?;
                         if !(n >= 0.0 && n.fract() == 0.0) {
-                            return Err(format!("{} {item}: bad list length {n}", el.name));
+                            return Err(Error::parse(format!(
+                                "{} {item}: bad list length {n}",
+                                el.name
+                            )));
                         }
                         let n = n as u64;
                         let need = if enc == Encoding::Ascii { 2 } else { t.size() };
                         if n > (body.left() / need) as u64 + 1 {
-                            return Err(format!(
+                            return Err(Error::parse(format!(
                                 "{} {item}: list of {n} values runs past the end of the file",
                                 el.name
-                            ));
+                            )));
                         }
                         let take = is_face && list_at == Some(k);
                         for _ in 0..n {
                             let v = body.value(*t)?;
                             if take {
                                 if !(v >= 0.0 && v < u32::MAX as f64 && v.fract() == 0.0) {
-                                    return Err(format!("face {item}: bad vertex index {v}"));
+                                    return Err(Error::parse(format!(
+                                        "face {item}: bad vertex index {v}"
+                                    )));
                                 }
                                 sink.corner(v as u32);
                             }
                         }
                         if take {
-                            sink.end_face().map_err(|e| format!("face {item}: {e}"))?;
+                            sink.end_face()
+                                .map_err(|e| Error::parse(format!("face {item}: {e}")))?;
                         }
                     }
                 }
@@ -371,6 +393,6 @@ mod tests {
     #[test]
     fn header_counts_larger_than_the_file_are_refused() {
         let b = b"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n\0\0\0\0";
-        assert!(parse(b).unwrap_err().contains("too short"));
+        assert!(parse(b).unwrap_err().to_string().contains("too short"));
     }
 }

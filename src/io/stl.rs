@@ -100,14 +100,11 @@ fn write_ascii(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
 /// Reads an STL file (binary or ASCII), welding bit-identical vertices.
 pub fn read(path: &Path) -> Result<Mesh> {
     let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    parse(&data).map_err(|message| Error::Format {
-        path: path.to_path_buf(),
-        message,
-    })
+    parse(&data).map_err(|e| e.in_file(path))
 }
 
 /// Parses STL bytes.
-pub fn parse(data: &[u8]) -> std::result::Result<Mesh, String> {
+pub fn parse(data: &[u8]) -> Result<Mesh> {
     parse_facets(data).map(|p| p.mesh)
 }
 
@@ -116,7 +113,7 @@ pub fn parse(data: &[u8]) -> std::result::Result<Mesh, String> {
 /// Binary if the size is exactly `84 + 50·n` for the header's facet count `n`; otherwise ASCII
 /// if the first word is `solid` (any case) and the text parses; otherwise an error naming the
 /// mismatch. No allocation is ever sized from the header alone.
-pub fn parse_facets(data: &[u8]) -> std::result::Result<Parsed, String> {
+pub fn parse_facets(data: &[u8]) -> Result<Parsed> {
     if data.len() >= 84 {
         let n = u32::from_le_bytes([data[80], data[81], data[82], data[83]]) as u64;
         if 84 + 50 * n == data.len() as u64 {
@@ -133,20 +130,23 @@ pub fn parse_facets(data: &[u8]) -> std::result::Result<Parsed, String> {
         return parse_ascii(data);
     }
     if data.len() < 84 {
-        return Err(format!("too short for STL ({} bytes)", data.len()));
+        return Err(Error::parse(format!(
+            "too short for STL ({} bytes)",
+            data.len()
+        )));
     }
     let n = u32::from_le_bytes([data[80], data[81], data[82], data[83]]) as u64;
-    Err(format!(
+    Err(Error::parse(format!(
         "binary STL header says {n} facets ({} bytes) but the file has {} bytes",
         84 + 50 * n,
         data.len()
-    ))
+    )))
 }
 
-fn parse_binary(data: &[u8], n: usize) -> std::result::Result<Parsed, String> {
+fn parse_binary(data: &[u8], n: usize) -> Result<Parsed> {
     use rayon::prelude::*;
     if n == 0 {
-        return Err("binary STL with zero facets".into());
+        return Err(Error::parse("binary STL with zero facets"));
     }
     // n is bounded by the file size here (checked by the caller).
     let f = |rec: &[u8], o: usize| f32::from_le_bytes([rec[o], rec[o + 1], rec[o + 2], rec[o + 3]]);
@@ -170,34 +170,36 @@ fn parse_binary(data: &[u8], n: usize) -> std::result::Result<Parsed, String> {
 /// ASCII STL as a stream of words; only `solid`/`endsolid` names are read to the end of their
 /// line. Keywords in any case; CR, LF or CRLF line ends; several solids in one file; text after
 /// the last `endsolid` ignored. Stored normals may be anything `f32` parses (`nan`, `+inf`).
-fn parse_ascii(data: &[u8]) -> std::result::Result<Parsed, String> {
+fn parse_ascii(data: &[u8]) -> Result<Parsed> {
     let mut words = Words::new(data);
     let mut w = ExactWelder::new(1024);
     let mut normals = Vec::new();
-    let num = |words: &mut Words, what: &str| -> std::result::Result<f32, String> {
+    let num = |words: &mut Words, what: &str| -> Result<f32> {
         let line = words.line;
         let tok = words
             .next()
-            .ok_or_else(|| format!("line {line}: file ends inside a facet"))?;
+            .ok_or_else(|| Error::parse(format!("line {line}: file ends inside a facet")))?;
         std::str::from_utf8(tok)
             .ok()
             .and_then(|s| s.parse::<f32>().ok())
             .ok_or_else(|| {
-                format!(
+                Error::parse(format!(
                     "line {line}: bad {what} '{}'",
                     String::from_utf8_lossy(&tok[..tok.len().min(24)])
-                )
+                ))
             })
     };
-    let expect = |words: &mut Words, kw: &str| -> std::result::Result<(), String> {
+    let expect = |words: &mut Words, kw: &str| -> Result<()> {
         let line = words.line;
         match words.next() {
             Some(t) if t.eq_ignore_ascii_case(kw.as_bytes()) => Ok(()),
-            Some(t) => Err(format!(
+            Some(t) => Err(Error::parse(format!(
                 "line {line}: expected '{kw}', found '{}'",
                 String::from_utf8_lossy(&t[..t.len().min(24)])
-            )),
-            None => Err(format!("line {line}: file ends where '{kw}' was expected")),
+            ))),
+            None => Err(Error::parse(format!(
+                "line {line}: file ends where '{kw}' was expected"
+            ))),
         }
     };
     let mut in_solid = false;
@@ -205,7 +207,10 @@ fn parse_ascii(data: &[u8]) -> std::result::Result<Parsed, String> {
     while let Some(tok) = words.next() {
         if tok.eq_ignore_ascii_case(b"solid") {
             if in_solid {
-                return Err(format!("line {}: 'solid' inside a solid", words.line));
+                return Err(Error::parse(format!(
+                    "line {}: 'solid' inside a solid",
+                    words.line
+                )));
             }
             words.skip_line();
             in_solid = true;
@@ -238,30 +243,30 @@ fn parse_ascii(data: &[u8]) -> std::result::Result<Parsed, String> {
                     num(&mut words, "vertex coordinate")?,
                 ];
                 w.corner(p)
-                    .map_err(|e| format!("line {}: {e}", words.line))?;
+                    .map_err(|e| Error::parse(format!("line {}: {e}", words.line)))?;
             }
             let l = words.line;
             match words.next() {
                 Some(t) if t.eq_ignore_ascii_case(b"endloop") => {}
                 Some(t) if t.eq_ignore_ascii_case(b"vertex") => {
-                    return Err(format!(
+                    return Err(Error::parse(format!(
                         "line {l}: facet starting on line {line} has more than three vertices"
-                    ))
+                    )))
                 }
-                _ => return Err(format!("line {l}: expected 'endloop'")),
+                _ => return Err(Error::parse(format!("line {l}: expected 'endloop'"))),
             }
             expect(&mut words, "endfacet")?;
             normals.push(n);
         } else {
-            return Err(format!(
+            return Err(Error::parse(format!(
                 "line {}: unexpected '{}' in ASCII STL",
                 words.line,
                 String::from_utf8_lossy(&tok[..tok.len().min(24)])
-            ));
+            )));
         }
     }
     if normals.is_empty() {
-        return Err("ASCII STL with no facets".into());
+        return Err(Error::parse("ASCII STL with no facets"));
     }
     Ok(Parsed {
         mesh: w.mesh,
@@ -311,6 +316,9 @@ mod tests {
         let mut buf = Vec::new();
         write(&tetra(), StlFormat::Binary, &mut buf).unwrap();
         buf.truncate(buf.len() - 7);
-        assert!(parse(&buf).unwrap_err().contains("header says 4 facets"));
+        assert!(parse(&buf)
+            .unwrap_err()
+            .to_string()
+            .contains("header says 4 facets"));
     }
 }

@@ -8,6 +8,7 @@
 //! copy is made and capped relative to what the file stores.
 
 use super::{Parsed, PolygonSink};
+use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use quick_xml::events::{BytesStart, Event};
 use std::collections::HashMap;
@@ -51,9 +52,9 @@ struct Object {
     components: Vec<(u64, Transform)>,
 }
 
-fn attr(e: &BytesStart, name: &str) -> Result<Option<String>, String> {
+fn attr(e: &BytesStart, name: &str) -> Result<Option<String>> {
     for a in e.attributes() {
-        let a = a.map_err(|e| format!("bad XML attribute: {e}"))?;
+        let a = a.map_err(|e| Error::parse(format!("bad XML attribute: {e}")))?;
         if a.key.local_name().as_ref() == name {
             return Ok(Some(a.value.to_string()));
         }
@@ -61,16 +62,20 @@ fn attr(e: &BytesStart, name: &str) -> Result<Option<String>, String> {
     Ok(None)
 }
 
-fn num<T: std::str::FromStr>(e: &BytesStart, name: &str) -> Result<T, String> {
-    let v =
-        attr(e, name)?.ok_or_else(|| format!("<{}> without {}", e.local_name().as_ref(), name))?;
-    v.trim()
-        .parse()
-        .map_err(|_| format!("bad {} '{}'", name, v.chars().take(24).collect::<String>()))
+fn num<T: std::str::FromStr>(e: &BytesStart, name: &str) -> Result<T> {
+    let v = attr(e, name)?
+        .ok_or_else(|| Error::parse(format!("<{}> without {}", e.local_name().as_ref(), name)))?;
+    v.trim().parse().map_err(|_| {
+        Error::parse(format!(
+            "bad {} '{}'",
+            name,
+            v.chars().take(24).collect::<String>()
+        ))
+    })
 }
 
 /// A `transform` attribute, its translation converted from model units to mm.
-fn transform(e: &BytesStart, scale: f64) -> Result<Transform, String> {
+fn transform(e: &BytesStart, scale: f64) -> Result<Transform> {
     let Some(t) = attr(e, "transform")? else {
         return Ok(IDENTITY);
     };
@@ -78,9 +83,9 @@ fn transform(e: &BytesStart, scale: f64) -> Result<Transform, String> {
         .split_whitespace()
         .map(|s| s.parse::<f64>())
         .collect::<Result<_, _>>()
-        .map_err(|_| "bad transform".to_string())?;
+        .map_err(|_| Error::parse("bad transform"))?;
     if v.len() != 12 || !v.iter().all(|x| x.is_finite()) {
-        return Err("a transform needs 12 finite numbers".into());
+        return Err(Error::parse("a transform needs 12 finite numbers"));
     }
     let mut m: Transform = v.try_into().expect("12 values");
     for t in &mut m[9..] {
@@ -89,19 +94,19 @@ fn transform(e: &BytesStart, scale: f64) -> Result<Transform, String> {
     Ok(m)
 }
 
-fn read_entry(zip: &mut zip::ZipArchive<Cursor<&[u8]>>, name: &str) -> Result<Vec<u8>, String> {
+fn read_entry(zip: &mut zip::ZipArchive<Cursor<&[u8]>>, name: &str) -> Result<Vec<u8>> {
     let f = zip
         .by_name(name)
-        .map_err(|e| format!("package has no readable {name}: {e}"))?;
+        .map_err(|e| Error::parse(format!("package has no readable {name}: {e}")))?;
     if f.size() > MAX_MODEL_BYTES {
-        return Err(format!("{name} is larger than 4 GiB"));
+        return Err(Error::parse(format!("{name} is larger than 4 GiB")));
     }
     let mut out = Vec::new();
     f.take(MAX_MODEL_BYTES + 1)
         .read_to_end(&mut out)
-        .map_err(|e| format!("{name}: {e}"))?;
+        .map_err(|e| Error::parse(format!("{name}: {e}")))?;
     if out.len() as u64 > MAX_MODEL_BYTES {
-        return Err(format!("{name} is larger than 4 GiB"));
+        return Err(Error::parse(format!("{name} is larger than 4 GiB")));
     }
     Ok(out)
 }
@@ -133,12 +138,12 @@ fn model_path(zip: &mut zip::ZipArchive<Cursor<&[u8]>>) -> String {
 }
 
 /// Parses a 3MF package.
-pub fn parse(data: &[u8]) -> Result<Parsed, String> {
-    let mut zip =
-        zip::ZipArchive::new(Cursor::new(data)).map_err(|e| format!("not a zip package: {e}"))?;
+pub fn parse(data: &[u8]) -> Result<Parsed> {
+    let mut zip = zip::ZipArchive::new(Cursor::new(data))
+        .map_err(|e| Error::parse(format!("not a zip package: {e}")))?;
     let path = model_path(&mut zip);
     let xml = read_entry(&mut zip, &path)?;
-    let text = std::str::from_utf8(&xml).map_err(|_| "model XML is not UTF-8".to_string())?;
+    let text = std::str::from_utf8(&xml).map_err(|_| Error::parse("model XML is not UTF-8"))?;
     let mut r = quick_xml::Reader::from_str(text);
     let mut objects: HashMap<u64, Object> = HashMap::new();
     let mut items: Vec<(u64, Transform)> = Vec::new();
@@ -146,9 +151,9 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
     let mut scale = 1.0f64;
     let mut stored_triangles = 0u64;
     loop {
-        let ev = r
-            .read_event()
-            .map_err(|e| format!("model XML: {e} (at byte {})", r.buffer_position()))?;
+        let ev = r.read_event().map_err(|e| {
+            Error::parse(format!("model XML: {e} (at byte {})", r.buffer_position()))
+        })?;
         let (e, empty) = match ev {
             Event::Start(e) => (e, false),
             Event::Empty(e) => (e, true),
@@ -171,50 +176,52 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
                     "foot" => 304.8,
                     "meter" => 1000.0,
                     u => {
-                        return Err(format!(
+                        return Err(Error::parse(format!(
                             "unknown unit '{}'",
                             u.chars().take(24).collect::<String>()
-                        ))
+                        )))
                     }
                 };
             }
             "object" => {
                 let id: u64 = num(&e, "id")?;
                 if objects.contains_key(&id) {
-                    return Err(format!("object id {id} defined twice"));
+                    return Err(Error::parse(format!("object id {id} defined twice")));
                 }
                 objects.insert(id, Object::default());
                 current = (!empty).then_some(id);
             }
             "vertex" => {
-                let id = current.ok_or("<vertex> outside an <object>")?;
-                let o = objects.get_mut(&id).ok_or("<vertex> outside an <object>")?;
+                let id = current.ok_or_else(|| Error::parse("<vertex> outside an <object>"))?;
+                let o = objects
+                    .get_mut(&id)
+                    .ok_or_else(|| Error::parse("<vertex> outside an <object>"))?;
                 let p: [f32; 3] = [num(&e, "x")?, num(&e, "y")?, num(&e, "z")?];
                 if !p.iter().all(|v| v.is_finite()) {
-                    return Err(format!("non-finite vertex coordinate {p:?}"));
+                    return Err(Error::parse(format!("non-finite vertex coordinate {p:?}")));
                 }
                 o.positions.extend(p.map(|v| (v as f64 * scale) as f32));
             }
             "triangle" => {
-                let id = current.ok_or("<triangle> outside an <object>")?;
+                let id = current.ok_or_else(|| Error::parse("<triangle> outside an <object>"))?;
                 let o = objects
                     .get_mut(&id)
-                    .ok_or("<triangle> outside an <object>")?;
+                    .ok_or_else(|| Error::parse("<triangle> outside an <object>"))?;
                 let t: [u32; 3] = [num(&e, "v1")?, num(&e, "v2")?, num(&e, "v3")?];
                 let nv = o.positions.len() / 3;
                 if t.iter().any(|&i| i as usize >= nv) {
-                    return Err(format!(
+                    return Err(Error::parse(format!(
                         "triangle {t:?} names a vertex past the {nv} vertices"
-                    ));
+                    )));
                 }
                 o.triangles.extend_from_slice(&t);
                 stored_triangles += 1;
             }
             "component" => {
-                let id = current.ok_or("<component> outside an <object>")?;
+                let id = current.ok_or_else(|| Error::parse("<component> outside an <object>"))?;
                 let o = objects
                     .get_mut(&id)
-                    .ok_or("<component> outside an <object>")?;
+                    .ok_or_else(|| Error::parse("<component> outside an <object>"))?;
                 o.components
                     .push((num(&e, "objectid")?, transform(&e, scale)?));
             }
@@ -223,16 +230,16 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
         }
     }
     if items.is_empty() {
-        return Err("no <build> <item>".into());
+        return Err(Error::parse("no <build> <item>"));
     }
     // Triangles after instancing, computed before copying anything.
-    fn count(objects: &HashMap<u64, Object>, id: u64, depth: usize) -> Result<u64, String> {
+    fn count(objects: &HashMap<u64, Object>, id: u64, depth: usize) -> Result<u64> {
         if depth > MAX_DEPTH {
-            return Err("components nested too deeply (or in a cycle)".into());
+            return Err(Error::parse("components nested too deeply (or in a cycle)"));
         }
         let o = objects
             .get(&id)
-            .ok_or_else(|| format!("reference to undefined object {id}"))?;
+            .ok_or_else(|| Error::parse(format!("reference to undefined object {id}")))?;
         let mut n = (o.triangles.len() / 3) as u64;
         for (c, _) in &o.components {
             n = n.saturating_add(count(objects, *c, depth + 1)?);
@@ -245,16 +252,16 @@ pub fn parse(data: &[u8]) -> Result<Parsed, String> {
     }
     let cap = 20_000_000 + 16 * stored_triangles;
     if total > cap {
-        return Err(format!(
+        return Err(Error::parse(format!(
             "build expands {stored_triangles} stored triangles to {total}, over the limit of {cap}"
-        ));
+        )));
     }
     fn emit(
         objects: &HashMap<u64, Object>,
         id: u64,
         m: &Transform,
         sink: &mut PolygonSink,
-    ) -> Result<(), String> {
+    ) -> Result<()> {
         let o = &objects[&id];
         let base = sink.vertex_count() as u32;
         for p in o.positions.chunks_exact(3) {

@@ -8,6 +8,7 @@
 //! have radius ≤ tolerance (no chaining across a long row of close points) and the result does not
 //! depend on hash order.
 
+use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use std::collections::HashMap;
 use std::hash::{BuildHasher, Hasher};
@@ -104,12 +105,12 @@ impl ExactWelder {
     }
 
     /// The vertex id of position `p`, creating it if new. Non-finite coordinates are an error.
-    pub fn vertex(&mut self, p: [f32; 3]) -> Result<u32, String> {
+    pub fn vertex(&mut self, p: [f32; 3]) -> Result<u32> {
         if !p.iter().all(|v| v.is_finite()) {
-            return Err(format!("non-finite vertex coordinate {p:?}"));
+            return Err(Error::parse(format!("non-finite vertex coordinate {p:?}")));
         }
         if self.index.len() >= u32::MAX as usize {
-            return Err("more than 2^32 vertices".into());
+            return Err(Error::parse("more than 2^32 vertices"));
         }
         let (id, new) = self.index.index(p);
         if new {
@@ -119,7 +120,7 @@ impl ExactWelder {
     }
 
     /// Adds one corner of the current facet.
-    pub fn corner(&mut self, p: [f32; 3]) -> Result<(), String> {
+    pub fn corner(&mut self, p: [f32; 3]) -> Result<()> {
         let id = self.vertex(p)?;
         self.mesh.indices.push(id);
         self.corners += 1;
@@ -160,11 +161,11 @@ struct Chunk {
 pub fn weld_facets_by(
     facets: usize,
     facet: impl Fn(usize) -> [[f32; 3]; 3] + Sync,
-) -> Result<Mesh, String> {
+) -> Result<Mesh> {
     use rayon::prelude::*;
     let count = 3 * facets;
     if count >= u32::MAX as usize {
-        return Err("more than 2^32 corners".into());
+        return Err(Error::parse("more than 2^32 corners"));
     }
     let corner = |c: usize| facet(c / 3)[c % 3];
     let n_chunks = count.div_ceil(CHUNK);
@@ -220,11 +221,11 @@ pub fn weld_facets_by(
             .position(|&s| s == u8::MAX)
             .map(|i| j * CHUNK + i)
     }) {
-        return Err(format!(
+        return Err(Error::parse(format!(
             "facet {}: non-finite vertex coordinate {:?}",
             c / 3 + 1,
             corner(c)
-        ));
+        )));
     }
     // 2. Each shard welds its corners, chunk after chunk: a vertex id (within the shard) per
     //    corner, and the first corner of each vertex.
@@ -304,7 +305,7 @@ pub fn weld_facets_by(
 
 /// Welds an indexed mesh whose vertex list may repeat positions (OBJ, OFF, PLY, 3MF): returns the
 /// mesh over distinct positions. Unreferenced vertices are kept (at their first occurrence).
-pub fn weld_indexed(positions: &[f32], indices: &[u32]) -> Result<Mesh, String> {
+pub fn weld_indexed(positions: &[f32], indices: &[u32]) -> Result<Mesh> {
     let nv = positions.len() / 3;
     let mut w = ExactWelder::new(nv.min(1 << 24));
     let mut remap = Vec::with_capacity(nv);
@@ -318,7 +319,7 @@ pub fn weld_indexed(positions: &[f32], indices: &[u32]) -> Result<Mesh, String> 
             remap
                 .get(i as usize)
                 .copied()
-                .ok_or_else(|| format!("vertex index {i} past the {nv} vertices"))
+                .ok_or_else(|| Error::parse(format!("vertex index {i} past the {nv} vertices")))
         })
         .collect::<Result<_, _>>()?;
     Ok(mesh)
@@ -468,7 +469,7 @@ mod tests {
 
         let mut bad = corners.clone();
         bad[3 * 60_000 + 2] = [1.0, f32::INFINITY, 0.0];
-        let e = weld(&bad).unwrap_err();
+        let e = weld(&bad).unwrap_err().to_string();
         assert!(e.starts_with("facet 60001:"), "{e}");
     }
 }

@@ -16,6 +16,7 @@
 //! stays open is reported, never dropped unless asked. Normals are recomputed by the writers.
 
 pub mod cgal;
+mod file;
 mod holes;
 pub mod remesh;
 mod split;
@@ -27,6 +28,7 @@ use crate::progress::Progress;
 use crate::topology::Topology;
 use rayon::prelude::*;
 
+pub use file::{repair_file, FileRepairReport};
 pub use holes::PLANAR_REL;
 
 /// How to repair.

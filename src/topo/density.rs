@@ -110,28 +110,23 @@ impl Density {
     /// Reads `.npy`, `.csv` or text (`.txt`, `.dat`, anything else) by extension.
     pub fn read(path: &Path, element_size: f64) -> Result<Density> {
         let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-        let fmt = |message: String| Error::Format {
-            path: path.to_path_buf(),
-            message,
-        };
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
             .unwrap_or("")
             .to_ascii_lowercase();
-        let (shape, data) = if ext == "npy" || bytes.starts_with(b"\x93NUMPY") {
-            let a = npy::parse(&bytes).map_err(fmt)?;
-            (a.shape, a.data)
+        let parsed = if ext == "npy" || bytes.starts_with(b"\x93NUMPY") {
+            npy::parse(&bytes).map(|a| (a.shape, a.data))
         } else {
-            let text = String::from_utf8(bytes).map_err(|_| fmt("not UTF-8 text".into()))?;
-            if ext == "csv" {
-                parse_csv(&text).map_err(fmt)?
-            } else {
-                parse_text(&text).map_err(fmt)?
+            match String::from_utf8(bytes) {
+                Err(_) => Err(Error::parse("not UTF-8 text")),
+                Ok(text) if ext == "csv" => parse_csv(&text),
+                Ok(text) => parse_text(&text),
             }
         };
+        let (shape, data) = parsed.map_err(|e| e.in_file(path))?;
         Density::from_array(&shape, &data, element_size).map_err(|e| match e {
-            Error::Invalid(m) => fmt(m),
+            Error::Invalid(m) => Error::parse(m).in_file(path),
             other => other,
         })
     }
@@ -147,7 +142,7 @@ fn index_text(shape: &[usize], mut i: usize) -> String {
 }
 
 /// CSV: one row of the 2D field per line, comma- (or semicolon-) separated.
-pub fn parse_csv(text: &str) -> std::result::Result<(Vec<usize>, Vec<f64>), String> {
+pub fn parse_csv(text: &str) -> Result<(Vec<usize>, Vec<f64>)> {
     let mut data = Vec::new();
     let mut cols = None;
     let mut rows = 0;
@@ -159,66 +154,68 @@ pub fn parse_csv(text: &str) -> std::result::Result<(Vec<usize>, Vec<f64>), Stri
         let vals: Vec<f64> = line
             .split([',', ';'])
             .map(|s| {
-                s.trim()
-                    .parse::<f64>()
-                    .map_err(|_| format!("line {}: '{}' is not a number", n + 1, s.trim()))
+                s.trim().parse::<f64>().map_err(|_| {
+                    Error::parse(format!("line {}: '{}' is not a number", n + 1, s.trim()))
+                })
             })
             .collect::<Result<_, _>>()?;
         match cols {
             None => cols = Some(vals.len()),
             Some(c) if c != vals.len() => {
-                return Err(format!(
+                return Err(Error::parse(format!(
                     "line {}: {} values, but the first row has {c}",
                     n + 1,
                     vals.len()
-                ))
+                )))
             }
             _ => {}
         }
         rows += 1;
         data.extend(vals);
     }
-    let cols = cols.ok_or("no data rows")?;
+    let cols = cols.ok_or_else(|| Error::parse("no data rows"))?;
     Ok((vec![rows, cols], data))
 }
 
 /// Text: a header line `ny nx` or `ny nx nz`, then the values, whitespace-separated, in C order
 /// of that shape (for 3D: all `nz` values of an element column together, as `numpy.savetxt` of
 /// the array reshaped to `(ny, nx·nz)` writes them).
-pub fn parse_text(text: &str) -> std::result::Result<(Vec<usize>, Vec<f64>), String> {
+pub fn parse_text(text: &str) -> Result<(Vec<usize>, Vec<f64>)> {
     let mut lines = text
         .lines()
         .map(str::trim)
         .filter(|l| !l.is_empty() && !l.starts_with('#'));
-    let head = lines.next().ok_or("empty file")?;
+    let head = lines.next().ok_or_else(|| Error::parse("empty file"))?;
     let shape: Vec<usize> = head
         .split_whitespace()
         .map(|s| {
             s.parse::<usize>().map_err(|_| {
-                format!("first line must give the dimensions (ny nx [nz]); got '{head}'")
+                Error::parse(format!(
+                    "first line must give the dimensions (ny nx [nz]); got '{head}'"
+                ))
             })
         })
         .collect::<Result<_, _>>()?;
     if !(2..=3).contains(&shape.len()) {
-        return Err(format!(
+        return Err(Error::parse(format!(
             "first line must give 2 or 3 dimensions (ny nx [nz]); got '{head}'"
-        ));
+        )));
     }
     let mut data = Vec::new();
     for l in lines {
         for s in l.split_whitespace() {
             data.push(
                 s.parse::<f64>()
-                    .map_err(|_| format!("'{s}' is not a number"))?,
+                    .map_err(|_| Error::parse(format!("'{s}' is not a number")))?,
             );
         }
     }
     let n: usize = shape.iter().product();
     if data.len() != n {
-        return Err(format!(
+        return Err(Error::parse(format!(
             "header says {shape:?} ({n} values) but the file holds {}",
             data.len()
-        ));
+        )));
     }
     Ok((shape, data))
 }

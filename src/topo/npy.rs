@@ -1,6 +1,7 @@
 //! NumPy's `.npy` format (versions 1–3): what optimisers in the field write. Reads float, integer
 //! and boolean arrays of either byte order, C or Fortran order; writes little-endian `f8`.
 
+use crate::error::{Error, Result};
 use std::io::Write;
 
 /// An n-dimensional array in C order.
@@ -11,34 +12,39 @@ pub struct Array {
 }
 
 /// Parses `.npy` bytes.
-pub fn parse(bytes: &[u8]) -> Result<Array, String> {
+pub fn parse(bytes: &[u8]) -> Result<Array> {
     if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
-        return Err("not a .npy file (missing the \\x93NUMPY magic)".into());
+        return Err(Error::parse(
+            "not a .npy file (missing the \\x93NUMPY magic)",
+        ));
     }
     let major = bytes[6];
     let (hlen, start) = match major {
         1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10),
         2 | 3 => {
             if bytes.len() < 12 {
-                return Err("truncated .npy header".into());
+                return Err(Error::parse("truncated .npy header"));
             }
             (
                 u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize,
                 12,
             )
         }
-        v => return Err(format!("unsupported .npy version {v}")),
+        v => return Err(Error::parse(format!("unsupported .npy version {v}"))),
     };
     let header = bytes
         .get(start..start + hlen)
-        .ok_or("truncated .npy header")?;
-    let header = std::str::from_utf8(header).map_err(|_| ".npy header is not text")?;
-    let descr = dict_value(header, "descr").ok_or(".npy header has no 'descr'")?;
+        .ok_or_else(|| Error::parse("truncated .npy header"))?;
+    let header =
+        std::str::from_utf8(header).map_err(|_| Error::parse(".npy header is not text"))?;
+    let descr =
+        dict_value(header, "descr").ok_or_else(|| Error::parse(".npy header has no 'descr'"))?;
     let descr = descr.trim_matches(|c| c == '\'' || c == '"');
     let fortran = dict_value(header, "fortran_order")
-        .ok_or(".npy header has no 'fortran_order'")?
+        .ok_or_else(|| Error::parse(".npy header has no 'fortran_order'"))?
         .starts_with("True");
-    let shape_txt = dict_value(header, "shape").ok_or(".npy header has no 'shape'")?;
+    let shape_txt =
+        dict_value(header, "shape").ok_or_else(|| Error::parse(".npy header has no 'shape'"))?;
     let shape: Vec<usize> = shape_txt
         .trim_start_matches('(')
         .split([',', ')'])
@@ -46,7 +52,7 @@ pub fn parse(bytes: &[u8]) -> Result<Array, String> {
         .filter(|s| !s.is_empty())
         .map(|s| {
             s.parse::<usize>()
-                .map_err(|_| format!("bad shape {shape_txt}"))
+                .map_err(|_| Error::parse(format!("bad shape {shape_txt}")))
         })
         .collect::<Result<_, _>>()?;
     let n: usize = shape.iter().product();
@@ -54,22 +60,22 @@ pub fn parse(bytes: &[u8]) -> Result<Array, String> {
     let (order, kind, size) = {
         let b = descr.as_bytes();
         if b.len() < 3 {
-            return Err(format!("unsupported dtype '{descr}'"));
+            return Err(Error::parse(format!("unsupported dtype '{descr}'")));
         }
         let size: usize = descr[2..]
             .parse()
-            .map_err(|_| format!("unsupported dtype '{descr}'"))?;
+            .map_err(|_| Error::parse(format!("unsupported dtype '{descr}'")))?;
         (b[0], b[1], size)
     };
     if body.len() < n * size {
-        return Err(format!(
+        return Err(Error::parse(format!(
             "data holds {} bytes, shape {shape:?} of {descr} needs {}",
             body.len(),
             n * size
-        ));
+        )));
     }
     let big = order == b'>';
-    let get = |i: usize| -> Result<f64, String> {
+    let get = |i: usize| -> Result<f64> {
         let mut raw = [0u8; 8];
         raw[..size].copy_from_slice(&body[i * size..(i + 1) * size]);
         if big {
@@ -86,7 +92,7 @@ pub fn parse(bytes: &[u8]) -> Result<Array, String> {
             (b'u', 4) => u32::from_le_bytes(raw[..4].try_into().unwrap()) as f64,
             (b'u', 2) => u16::from_le_bytes(raw[..2].try_into().unwrap()) as f64,
             (b'u' | b'b', 1) => raw[0] as f64,
-            _ => return Err(format!("unsupported dtype '{descr}'")),
+            _ => return Err(Error::parse(format!("unsupported dtype '{descr}'"))),
         })
     };
     let flat: Vec<f64> = (0..n).map(get).collect::<Result<_, _>>()?;

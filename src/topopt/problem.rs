@@ -315,19 +315,20 @@ struct PassiveSpec {
 /// Reads a TOML problem file.
 pub fn from_toml(path: &Path) -> Result<Problem> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    parse_toml(&text, &path.display().to_string()).map_err(|message| Error::Format {
-        path: path.to_path_buf(),
-        message,
-    })
+    parse_toml(&text, &path.display().to_string()).map_err(|e| e.in_file(path))
 }
 
 /// Parses a TOML problem description (`name` labels the result).
-pub fn parse_toml(text: &str, name: &str) -> std::result::Result<Problem, String> {
-    let f: ProblemFile = toml::from_str(text).map_err(|e| e.message().to_string())?;
+pub fn parse_toml(text: &str, name: &str) -> Result<Problem> {
+    let f: ProblemFile = toml::from_str(text).map_err(|e| Error::parse(e.message()))?;
     let physics = match f.physics.as_deref().unwrap_or("elastic") {
         "elastic" => Physics::Elastic,
         "heat" => Physics::Heat,
-        other => return Err(format!("unknown physics '{other}' (elastic, heat)")),
+        other => {
+            return Err(Error::parse(format!(
+                "unknown physics '{other}' (elastic, heat)"
+            )))
+        }
     };
     let mut p = Problem {
         name: name.to_string(),
@@ -343,13 +344,16 @@ pub fn parse_toml(text: &str, name: &str) -> std::result::Result<Problem, String
         emin: if physics == Physics::Heat { 1e-3 } else { 1e-9 },
     };
     if p.nelx == 0 || p.nely == 0 {
-        return Err("nelx and nely must be at least 1".into());
+        return Err(Error::parse("nelx and nely must be at least 1"));
     }
     if !(p.volfrac > 0.0 && p.volfrac < 1.0) {
-        return Err(format!("volfrac must be in (0, 1), got {}", p.volfrac));
+        return Err(Error::parse(format!(
+            "volfrac must be in (0, 1), got {}",
+            p.volfrac
+        )));
     }
     if !(p.element_size > 0.0 && p.element_size.is_finite()) {
-        return Err("element_size must be a positive length in mm".into());
+        return Err(Error::parse("element_size must be a positive length in mm"));
     }
     let d = p.dofs_per_node();
     let zmax = p.nelz;
@@ -357,10 +361,12 @@ pub fn parse_toml(text: &str, name: &str) -> std::result::Result<Problem, String
     let nodes_in = |x: [usize; 2], y: [usize; 2], z: Option<[usize; 2]>, what: &str| {
         let z = z.unwrap_or([0, 0]);
         if x[0] > x[1] || y[0] > y[1] || z[0] > z[1] {
-            return Err(format!("{what}: a range [lo, hi] has lo > hi"));
+            return Err(Error::parse(format!(
+                "{what}: a range [lo, hi] has lo > hi"
+            )));
         }
         if x[1] > g.nelx || y[1] > g.nely || z[1] > zmax {
-            return Err(format!(
+            return Err(Error::parse(format!(
                 "{what}: node range beyond the {}×{}{} mesh",
                 g.nelx,
                 g.nely,
@@ -369,7 +375,7 @@ pub fn parse_toml(text: &str, name: &str) -> std::result::Result<Problem, String
                 } else {
                     String::new()
                 }
-            ));
+            )));
         }
         let mut v = Vec::new();
         for iz in z[0]..=z[1] {
@@ -390,7 +396,11 @@ pub fn parse_toml(text: &str, name: &str) -> std::result::Result<Problem, String
                 ('y', Physics::Elastic) => 1,
                 ('z', Physics::Elastic) if p.nelz > 0 => 2,
                 (',' | ' ', _) => continue,
-                _ => return Err(format!("support: cannot fix '{c}' in this problem")),
+                _ => {
+                    return Err(Error::parse(format!(
+                        "support: cannot fix '{c}' in this problem"
+                    )))
+                }
             };
             p.fixed.extend(nodes.iter().map(|n| d * n + a));
         }
@@ -398,7 +408,9 @@ pub fn parse_toml(text: &str, name: &str) -> std::result::Result<Problem, String
     for l in &f.load {
         let nodes = nodes_in(l.x, l.y, l.z, "load")?;
         if l.f.len() != d || l.f.iter().any(|v| !v.is_finite()) {
-            return Err(format!("load: f needs {d} finite value(s) per node"));
+            return Err(Error::parse(format!(
+                "load: f needs {d} finite value(s) per node"
+            )));
         }
         for n in nodes {
             for (a, &v) in l.f.iter().enumerate() {
@@ -413,7 +425,7 @@ pub fn parse_toml(text: &str, name: &str) -> std::result::Result<Problem, String
         for s in &f.passive {
             let z = s.z.unwrap_or([0, 1]);
             if s.x[1] > p.nelx || s.y[1] > p.nely || z[1] > p.nelz.max(1) {
-                return Err("passive: element range beyond the mesh".into());
+                return Err(Error::parse("passive: element range beyond the mesh"));
             }
             for iz in z[0]..z[1] {
                 for ix in s.x[0]..s.x[1] {
@@ -429,7 +441,7 @@ pub fn parse_toml(text: &str, name: &str) -> std::result::Result<Problem, String
             }
         }
     }
-    p.check().map_err(|e| e.to_string())?;
+    p.check().map_err(|e| Error::parse(e.to_string()))?;
     Ok(p)
 }
 

@@ -4,6 +4,7 @@
 
 use super::calibrate::{self, Calibration, Connectivity, FeasibleRange};
 use super::{Domain, Lattice, LatticeFamily, MeshingStats, Structure, Surface};
+use crate::check::Verdict;
 use crate::error::{Error, Result};
 use crate::field::Aabb;
 use crate::instance;
@@ -130,6 +131,19 @@ pub struct TpmsReport {
     pub timings: Timings,
     pub warnings: Vec<String>,
     pub output: Option<String>,
+}
+
+impl TpmsReport {
+    /// The part's verdict: CGAL's checks (on the part, its template or its tiles), one piece
+    /// (unless fragments were kept on purpose), and the density.
+    pub fn verdict(&self) -> Verdict {
+        let kept_on_purpose = !self.fragments.removed && self.fragments.count > 0;
+        Verdict {
+            one_piece: self.one_piece.filter(|_| !kept_on_purpose),
+            density_met: Some(self.density_met),
+            ..self.checks.verdict()
+        }
+    }
 }
 
 impl TpmsJob {
@@ -358,7 +372,7 @@ impl TpmsJob {
                 self.density
             ));
         }
-        if !checks.is_valid_solid() && (checks.self_intersection_checked || !checks.closed) {
+        if !checks.verdict().is_valid_solid() {
             warnings.push(
                 "CGAL did not find the mesh a valid closed, outward, self-intersection-free solid"
                     .into(),

@@ -1,0 +1,35 @@
+//! Standard output for the commands. A reader that goes away early (`latvox check big.stl --json
+//! | head`) ends the process quietly with exit code 0, as a pipe's writer is expected to, where
+//! `println!` would panic.
+
+use std::io::Write;
+
+/// Writes `args` and a newline to stdout; on a closed pipe, exits with 0 at once.
+pub(crate) fn line(args: std::fmt::Arguments) {
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_fmt(args).and_then(|()| out.write_all(b"\n")) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        // Any other failure to print (a full disk behind a redirect) is the shell's to see.
+        drop(out);
+        eprintln!("latvox: standard output: {e}");
+        std::process::exit(2);
+    }
+}
+
+/// `println!` for the commands: see [`line`].
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        $crate::cli::out::line(format_args!($($arg)*))
+    };
+}
+pub(crate) use outln;
+
+/// Prints `value` as pretty JSON on stdout.
+pub(crate) fn json<T: serde::Serialize>(value: &T) {
+    outln!(
+        "{}",
+        serde_json::to_string_pretty(value).expect("JSON of plain values")
+    );
+}

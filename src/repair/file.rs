@@ -1,0 +1,101 @@
+//! Repairing a mesh file, as `latvox repair` does: check the input, repair it, write the result,
+//! and give the verdict on the file as written and read back, as the next program will see it.
+
+use super::{repair, RepairOptions, RepairReport};
+use crate::check::{check, read_file, CheckOptions, CheckReport, Defects, Verdict};
+use crate::error::{Error, Result};
+use crate::io::{Format, ReadOptions, Reading};
+use crate::progress::Progress;
+use crate::sink::MeshFile;
+use std::path::Path;
+
+/// Everything `latvox repair` reports.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct FileRepairReport {
+    /// The input file, as named.
+    pub input: String,
+    /// The output file, as named.
+    pub output: String,
+    /// The input's format.
+    pub format: Format,
+    pub reading: Reading,
+    /// The input's check (self-intersections are looked for on the result only).
+    pub before: CheckReport,
+    pub defects_before: Defects,
+    /// What repair changed.
+    pub repair: RepairReport,
+    /// Stored normals of the input that disagreed with the winding (the writers recompute them).
+    pub normals_recomputed: u64,
+    /// The check of the file as written and read back.
+    pub after: CheckReport,
+    pub defects_after: Defects,
+    /// The verdict on `after` (in JSON, the one flag `valid_solid`).
+    #[serde(
+        rename = "valid_solid",
+        serialize_with = "crate::check::verdict::valid_solid"
+    )]
+    pub verdict: Verdict,
+}
+
+/// Reads `input`, checks it, repairs it, writes the result to `output` atomically and checks the
+/// file as written. Vertices closer than `check_opts.tolerance` merge on reading the input. A
+/// repair that leaves no facet is an error, and nothing is written.
+pub fn repair_file(
+    input: &Path,
+    output: &MeshFile,
+    check_opts: &CheckOptions,
+    opts: &RepairOptions,
+    progress: &Progress,
+) -> Result<FileRepairReport> {
+    let loaded = read_file(input, check_opts, progress)?;
+    // CGAL's self-intersection test (the costliest check) runs once, on the result: repair does
+    // not mend self-intersections, so the count before would only repeat it.
+    let before = {
+        let _s = progress.stage("checking the input");
+        let opts = CheckOptions {
+            self_intersections: false,
+            ..*check_opts
+        };
+        check(&loaded.mesh, loaded.normals.as_deref(), &opts)?
+    };
+    let (mesh, changes) = repair(&loaded.mesh, opts, progress)?;
+    if mesh.triangle_count() == 0 {
+        return Err(Error::invalid(format!(
+            "{}: nothing is left after repair (every facet was degenerate{}); no file written",
+            input.display(),
+            if opts.drop_open_shells {
+                " or in an open shell"
+            } else {
+                ""
+            }
+        )));
+    }
+    {
+        let _s = progress.stage("writing");
+        output.save(&mesh)?;
+    }
+    // The verdict is on the file as written and read back, as the next program will see it
+    // (STL, for one, welds vertices by position).
+    let after = {
+        let _s = progress.stage("checking the written file");
+        let written = crate::io::read(&output.path, &ReadOptions::default())?;
+        check(&written.mesh, written.normals.as_deref(), check_opts)?
+    };
+    let normals_recomputed = before
+        .normals
+        .map(|n| n.reversed + n.inaccurate + n.unset)
+        .unwrap_or(0);
+    Ok(FileRepairReport {
+        input: input.display().to_string(),
+        output: output.path.display().to_string(),
+        format: loaded.format,
+        reading: loaded.reading(),
+        defects_before: Defects::from(&before),
+        before,
+        repair: changes,
+        normals_recomputed,
+        defects_after: Defects::from(&after),
+        verdict: after.verdict(),
+        after,
+    })
+}
