@@ -548,6 +548,7 @@ fn a_missing_folder_is_named_as_the_user_gave_it() {
         );
         assert!(files_in(dir.path()).is_empty());
     }
+}
 
 /// Triangles of an OBJ file, read here: `v x y z` and `f a b c` lines (1-based, `a/t/n` corners
 /// allowed); also the number of `v` lines.
