@@ -693,7 +693,7 @@ fn a_closed_pipe_ends_quietly() {
 
     // A summary printed into a pipe closed before the first line.
     let mut child = latvox()
-        .args(["tpms", "--cells", "1", "-r", "8", "-q", "-o", "one.stl"])
+        .args(["tpms", "--cells", "1", "-r", "16", "-q", "-o", "one.stl"])
         .current_dir(dir.path())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
