@@ -29,7 +29,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn write_npy(path: &Path, shape: &[usize], data: &[f64]) {
     let mut buf = Vec::new();
-    latvox::topo::npy::write(&mut buf, shape, data).unwrap();
+    latvox::io::npy::write(&mut buf, shape, data).unwrap();
     std::fs::write(path, buf).unwrap();
 }
 

@@ -2,36 +2,27 @@
 //! printable, verified meshes. Rust samples fields and orchestrates; OpenVDB holds the sparse
 //! level sets and meshes them; CGAL verifies the result.
 //!
-//! Stages, one module each: [`field`] → [`grid`] → [`extract`] → [`mesh`] → [`verify`] →
-//! [`io`] / [`sink`] (files).
-//! Capabilities: [`tpms`], [`check`] and [`repair`] (any mesh file, seed 001's defects),
-//! [`topopt`] (SIMP optimiser), [`topo`] (density fields to STL and CAD), [`cad`] (B-spline
+//! Stages, one folder each: [`field`] (implicit solids) → [`grid`] (OpenVDB level sets) →
+//! [`mesh`] (extraction, snapping, tiles, instancing, and the [`mesh::pipeline`] that takes any
+//! clipped field to a verified mesh at its target density) → [`check`] (latvox's checks and
+//! CGAL's) → [`io`] (readers, writers, sinks, atomic output).
+//! Capabilities: [`tpms`], [`repair`] (any mesh file, seed 001's defects), [`topopt`] (SIMP
+//! optimiser), [`interpret`] (density fields to printable parts and CAD), [`cad`] (B-spline
 //! curves, IGES, DXF), [`batch`] (many jobs, resumable, sharded over Slurm arrays).
 
 pub mod batch;
 pub mod cad;
 pub mod check;
 pub mod error;
-pub mod extract;
 pub(crate) mod ffi;
 pub mod field;
 pub mod grid;
-pub mod instance;
+pub mod interpret;
 pub mod io;
 pub mod mesh;
-pub mod output;
-pub mod pieces;
-pub mod pipeline;
 pub mod progress;
 pub mod repair;
-pub mod sink;
-pub mod snap;
-pub mod tile;
-pub mod topo;
-pub mod topology;
 pub mod topopt;
 pub mod tpms;
-pub mod triangulate;
-pub mod verify;
 
 pub use error::{Error, Result};

@@ -613,7 +613,7 @@ fn tiled_self_intersection_search_finds_the_pairs_of_the_whole_search() {
     ] {
         let mesh = latvox::io::read(&file, &Default::default()).unwrap().mesh;
         let keep: Vec<u32> = (0..mesh.triangle_count() as u32)
-            .filter(|&f| !latvox::topology::repeats_vertex(&mesh, f as usize))
+            .filter(|&f| !latvox::mesh::topology::repeats_vertex(&mesh, f as usize))
             .collect();
         let whole = soup_self_intersections_in_tiles(&mesh, &keep, None, usize::MAX, 0).unwrap();
         assert!(whole.0 > 0, "{}", file.display());

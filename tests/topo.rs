@@ -58,7 +58,7 @@ fn optimised(problem: &str, dir: &Path) -> PathBuf {
 
 /// Elements at or above `cutoff` in an .npy, counted here (not by latvox's reader's layout).
 fn elements_above(npy: &Path, cutoff: f64) -> usize {
-    let a = latvox::topo::npy::parse(&std::fs::read(npy).unwrap()).unwrap();
+    let a = latvox::io::npy::parse(&std::fs::read(npy).unwrap()).unwrap();
     a.data.iter().filter(|&&v| v >= cutoff).count()
 }
 
@@ -374,7 +374,7 @@ fn csv_and_text_inputs_match_npy() {
     let dir = tempdir();
     let d = dir.path();
     let npy = optimised("cantilever", d);
-    let a = latvox::topo::npy::parse(&std::fs::read(&npy).unwrap()).unwrap();
+    let a = latvox::io::npy::parse(&std::fs::read(&npy).unwrap()).unwrap();
     let (ny, nx) = (a.shape[0], a.shape[1]);
     let rows: Vec<String> = (0..ny)
         .map(|y| {
@@ -426,7 +426,7 @@ fn bad_density_inputs_exit_2_with_one_line_and_write_nothing() {
     let d = dir.path();
     let write_npy = |name: &str, shape: &[usize], data: &[f64]| {
         let mut buf = Vec::new();
-        latvox::topo::npy::write(&mut buf, shape, data).unwrap();
+        latvox::io::npy::write(&mut buf, shape, data).unwrap();
         std::fs::write(d.join(name), buf).unwrap();
     };
     write_npy("nan.npy", &[2, 3], &[0.0, 1.0, f64::NAN, 0.5, 0.5, 0.5]);

@@ -46,7 +46,7 @@ fn latvox_topopt(args: &[&str]) -> (serde_json::Value, Vec<f64>) {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    let arr = latvox::topo::npy::parse(&std::fs::read(&npy).unwrap()).unwrap();
+    let arr = latvox::io::npy::parse(&std::fs::read(&npy).unwrap()).unwrap();
     (json(&rep), arr.data)
 }
 
@@ -145,7 +145,7 @@ fn cantilever_3d_matches_top3d() {
         .expect("python3");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     compare("top3d cantilever 16x6x3", &ours, &json(&out));
-    let r = latvox::topo::npy::parse(&std::fs::read(&npy).unwrap()).unwrap();
+    let r = latvox::io::npy::parse(&std::fs::read(&npy).unwrap()).unwrap();
     assert_eq!(r.shape, vec![6, 16, 3]);
     let worst = r
         .data

@@ -1,21 +1,17 @@
 //! latvox's mesh readers, compiled from latvox's own source files for fuzzing. Only the modules
-//! the readers need are included (errors, mesh, polygon triangulation, atomic output, io), so
+//! the readers need are included (errors, fields, the mesh type, polygon triangulation, io), so
 //! the fuzz build never compiles the C++ bridges. `check` holds the invariants every target
 //! asserts on a successful parse.
 #![allow(dead_code, unused_imports)]
 
 #[path = "../../src/error.rs"]
 pub mod error;
-#[path = "../../src/field.rs"]
+#[path = "../../src/field/mod.rs"]
 pub mod field;
 #[path = "../../src/io/mod.rs"]
 pub mod io;
-#[path = "../../src/mesh.rs"]
+
 pub mod mesh;
-#[path = "../../src/output.rs"]
-pub mod output;
-#[path = "../../src/triangulate.rs"]
-pub mod triangulate;
 
 pub use error::{Error, Result};
 

@@ -231,7 +231,7 @@ impl Context<'_> {
                 std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, e))?;
             }
             // This process owns the job now: what a killed run left half-written goes.
-            crate::output::remove_stale_temporaries(&p)?;
+            crate::io::atomic::remove_stale_temporaries(&p)?;
         }
         let done = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| task.run())).map_err(
             |panic| {
@@ -283,7 +283,7 @@ impl Context<'_> {
             "batch".into(),
             serde_json::to_value(&provenance).map_err(|e| Error::invalid(e.to_string()))?,
         );
-        crate::output::write_json(&report_path, &report)?;
+        crate::io::atomic::write_json(&report_path, &report)?;
         Ok((outcome, done.warnings.len()))
     }
 }
@@ -311,7 +311,7 @@ mod tests {
             match self.behaviour {
                 "panic" => panic!("fake failure"),
                 "nothing" => {}
-                _ => crate::output::write_atomic(&self.output, |w| w.write_all(b"part"))?,
+                _ => crate::io::atomic::write_atomic(&self.output, |w| w.write_all(b"part"))?,
             }
             Ok(TaskReport {
                 report: serde_json::json!({ "kind": "fake" }),

@@ -130,11 +130,11 @@ impl Summary {
     }
 
     pub fn write_json(&self, path: &Path) -> Result<()> {
-        crate::output::write_json(path, self)
+        crate::io::atomic::write_json(path, self)
     }
 
     pub fn write_csv(&self, path: &Path) -> Result<()> {
-        crate::output::write_atomic(path, |w| {
+        crate::io::atomic::write_atomic(path, |w| {
             writeln!(
                 w,
                 "job,status,seconds,output,report,command,origin,hash,run_id,warnings,error"

@@ -2,11 +2,11 @@
 //! by side, and join their findings into one [`Verdict`] and one report.
 
 use super::{check, CheckOptions, CheckReport, Verdict};
+use crate::check::cgal::Verification;
 use crate::error::Result;
 use crate::io::{Format, Loaded, ReadOptions, Reading};
 use crate::mesh::EdgeStats;
 use crate::progress::Progress;
-use crate::verify::Verification;
 use std::path::Path;
 
 /// The defect classes found, with their counts, in the order [`CheckReport::defects`] gives
@@ -70,7 +70,7 @@ pub fn check_file(
         let _s = progress.stage("checking");
         rayon::join(
             || check(mesh, loaded.normals.as_deref(), opts),
-            || crate::verify::verify(mesh, false),
+            || crate::check::cgal::verify(mesh, false),
         )
     };
     let (report, mut cgal) = (report?, cgal?);

@@ -2,7 +2,7 @@
 //! rule, one exit code, whichever check (latvox's own, CGAL's, or both) made the findings.
 
 use super::CheckReport;
-use crate::verify::Verification;
+use crate::check::cgal::Verification;
 
 /// What a check found on the properties that make a mesh a printable solid.
 ///

@@ -62,7 +62,7 @@ impl CheckFlags {
 
 pub fn run(a: &CheckArgs, quiet: bool) -> Result<i32> {
     if let Some(r) = &a.common.report {
-        latvox::output::check_writable(r)?;
+        latvox::io::atomic::check_writable(r)?;
     }
     let progress = latvox::progress::Progress::new(quiet);
     let r = check_file(&a.file, &a.common.options(), &progress)?;

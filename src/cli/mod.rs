@@ -125,7 +125,7 @@ pub(crate) fn parse_tile(s: &str) -> std::result::Result<i64, String> {
 }
 
 pub(crate) fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
-    latvox::output::write_json(path, value)
+    latvox::io::atomic::write_json(path, value)
 }
 
 /// Writes `value` to `report` if given and prints it if `json`; returns whether it was printed
@@ -145,7 +145,7 @@ pub(crate) fn emit_json(
 }
 
 /// CGAL's findings, as the summaries print them.
-pub(crate) fn cgal_findings(c: &latvox::verify::Verification) -> String {
+pub(crate) fn cgal_findings(c: &latvox::check::cgal::Verification) -> String {
     format!(
         "closed {}  outward {}  manifold {}  self-intersections {}",
         yes(c.closed),

@@ -4,8 +4,8 @@
 use super::check::{print_header, print_summary};
 use super::out::outln;
 use clap::Args;
+use latvox::io::sink::MeshFile;
 use latvox::repair::{repair_file, RepairOptions};
-use latvox::sink::MeshFile;
 use latvox::Result;
 use std::path::PathBuf;
 
@@ -59,10 +59,10 @@ pub struct RepairArgs {
 }
 
 pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
-    latvox::output::check_writable(&a.output)?;
+    latvox::io::atomic::check_writable(&a.output)?;
     let output = MeshFile::new(&a.output, a.ascii)?;
     if let Some(r) = &a.common.report {
-        latvox::output::check_writable(r)?;
+        latvox::io::atomic::check_writable(r)?;
     }
     let opts = RepairOptions {
         fill_holes: !a.no_fill,

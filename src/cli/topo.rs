@@ -3,10 +3,10 @@
 use super::out::outln;
 use super::{cgal_findings, write_json};
 use clap::Args;
-use latvox::sink::MeshFile;
-use latvox::topo::job::{self, TopoJob};
-use latvox::topo::volume::Smoothing;
-use latvox::topo::{CleanOptions, Density};
+use latvox::interpret::job::{self, TopoJob};
+use latvox::interpret::volume::Smoothing;
+use latvox::interpret::{CleanOptions, Density};
+use latvox::io::sink::MeshFile;
 use latvox::{Error, Result};
 use std::path::PathBuf;
 
@@ -174,7 +174,7 @@ pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
         &a.cleaned,
     ];
     for f in outputs.into_iter().flatten() {
-        latvox::output::check_writable(f)?;
+        latvox::io::atomic::check_writable(f)?;
     }
     let output = MeshFile::new(&a.output, a.ascii)?;
     let progress = latvox::progress::Progress::new(quiet);
@@ -187,7 +187,7 @@ pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
             .unwrap_or_default()
     };
     if let Some(p) = &a.iges {
-        latvox::output::write_atomic(p, |w| {
+        latvox::io::atomic::write_atomic(p, |w| {
             latvox::cad::iges::write(w, &r.adaptive, &name(p), &stamp)
         })?;
         if a.uniform_too {
@@ -196,16 +196,16 @@ pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_default();
             let u = p.with_file_name(format!("{stem}-uniform.igs"));
-            latvox::output::write_atomic(&u, |w| {
+            latvox::io::atomic::write_atomic(&u, |w| {
                 latvox::cad::iges::write(w, &r.uniform, &name(&u), &stamp)
             })?;
         }
     }
     if let Some(p) = &a.dxf {
-        latvox::output::write_atomic(p, |w| latvox::cad::dxf::write(w, &r.adaptive))?;
+        latvox::io::atomic::write_atomic(p, |w| latvox::cad::dxf::write(w, &r.adaptive))?;
     }
     if let Some(p) = &a.boundary {
-        latvox::output::write_atomic(p, |w| {
+        latvox::io::atomic::write_atomic(p, |w| {
             writeln!(w, "loop,x,y")?;
             for (k, l) in r.loops.iter().enumerate() {
                 for q in l {
@@ -235,10 +235,10 @@ pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
         } else {
             vec![ny, nx]
         };
-        latvox::output::write_atomic(p, |w| latvox::topo::npy::write(w, &shape, &v))?;
+        latvox::io::atomic::write_atomic(p, |w| latvox::io::npy::write(w, &shape, &v))?;
     }
     let images = match &a.images {
-        Some(prefix) => latvox::topo::images::write_stages(&r.cleaned, prefix)?,
+        Some(prefix) => latvox::interpret::images::write_stages(&r.cleaned, prefix)?,
         None => Vec::new(),
     };
     if let Some(p) = &a.report {

@@ -154,9 +154,9 @@ pub fn run(a: &TopoptArgs, quiet: bool) -> Result<i32> {
     };
     let mut s = Settings::new(a.volfrac.unwrap_or(p.volfrac), a.penal, a.rmin, filter);
     s.max_iterations = a.max_iterations;
-    latvox::output::check_writable(&a.output)?;
+    latvox::io::atomic::check_writable(&a.output)?;
     for f in [&a.log, &a.report].into_iter().flatten() {
-        latvox::output::check_writable(f)?;
+        latvox::io::atomic::check_writable(f)?;
     }
     let progress = latvox::progress::Progress::new(quiet);
     let verbose = !quiet;
@@ -166,9 +166,9 @@ pub fn run(a: &TopoptArgs, quiet: bool) -> Result<i32> {
         }
     })?;
     let (shape, data) = topopt::to_array(&p, &r.densities);
-    latvox::output::write_atomic(&a.output, |w| latvox::topo::npy::write(w, &shape, &data))?;
+    latvox::io::atomic::write_atomic(&a.output, |w| latvox::io::npy::write(w, &shape, &data))?;
     if let Some(log) = &a.log {
-        latvox::output::write_atomic(log, |w| {
+        latvox::io::atomic::write_atomic(log, |w| {
             writeln!(w, "iteration,compliance,volume,change")?;
             for i in 0..r.iterations {
                 writeln!(

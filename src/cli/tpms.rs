@@ -6,7 +6,7 @@ use super::{
     parse_tile, parse_unit, write_json,
 };
 use clap::Args;
-use latvox::sink::MeshFile;
+use latvox::io::sink::MeshFile;
 use latvox::tpms::{Domain, Structure, Surface, TpmsJob, TpmsReport};
 use latvox::{Error, Result};
 use std::path::PathBuf;
@@ -143,7 +143,7 @@ fn domain(a: &TpmsArgs) -> Result<Domain> {
 pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
     // Fail on an unwritable destination before the work, not after.
     if let Some(r) = &a.report {
-        latvox::output::check_writable(r)?;
+        latvox::io::atomic::check_writable(r)?;
     }
     let report = execute(a, &latvox::progress::Progress::new(quiet))?;
     if let Some(r) = &a.report {
@@ -174,7 +174,7 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
         memory: a.memory,
         keep_fragments: a.keep_fragments,
     };
-    latvox::output::check_writable(&a.output)?;
+    latvox::io::atomic::check_writable(&a.output)?;
     // The part goes to a temporary file that becomes the output only once the job is done.
     let mut sink = MeshFile::new(&a.output, a.ascii)?.sink()?;
     let mut report = job.run_into(progress, &mut sink)?;

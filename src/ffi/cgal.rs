@@ -1,4 +1,4 @@
-//! The CGAL half of the C++ bridge. Raw declarations only; `crate::verify` wraps them safely.
+//! The CGAL half of the C++ bridge. Raw declarations only; `crate::check::cgal` wraps them safely.
 
 #[cxx::bridge(namespace = "latvox")]
 pub(crate) mod ffi {

@@ -1,5 +1,5 @@
 //! OpenVDB's level-set smoothing, a translation unit of its own (`cpp/vdb_filter.cc`). Raw
-//! declarations only; `crate::topo::volume` wraps them safely.
+//! declarations only; `crate::interpret::volume` wraps them safely.
 
 #[cxx::bridge(namespace = "latvox")]
 pub(crate) mod ffi {

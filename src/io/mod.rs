@@ -3,14 +3,17 @@
 //! Every reader returns the same thing — an indexed [`Mesh`] with bit-identical vertices welded,
 //! polygons cut into triangles — and treats its input as hostile: counts in headers only bound
 //! loops, never size an allocation beyond what the bytes present can hold; a bad byte gives an
-//! error naming where, never a panic. Writers go through [`crate::output`]'s atomic writes.
+//! error naming where, never a panic. Writers go through [`crate::io::atomic`]'s atomic writes.
 //!
 //! The format is chosen by the file's extension (`.stl .obj .off .ply .3mf`); files without a
 //! known extension are recognised by their first bytes.
 
+pub mod atomic;
+pub mod npy;
 pub mod obj;
 pub mod off;
 pub mod ply;
+pub mod sink;
 pub mod stl;
 pub mod threemf;
 pub mod weld;
@@ -252,7 +255,7 @@ impl PolygonSink {
                         [0, 1, 2].map(|a| self.positions[i + a] as f64)
                     })
                     .collect();
-                match crate::triangulate::triangulate_polygon(&pts) {
+                match crate::mesh::triangulate::triangulate_polygon(&pts) {
                     Some(tris) => {
                         for t in tris {
                             self.indices.extend(t.map(|k| c[k]));

@@ -277,7 +277,7 @@ fn parse_ascii(data: &[u8]) -> Result<Parsed> {
 
 /// Writes `mesh` to `path` atomically.
 pub fn save(mesh: &Mesh, format: StlFormat, path: &Path) -> Result<()> {
-    crate::output::write_atomic(path, |w| write(mesh, format, w))
+    crate::io::atomic::write_atomic(path, |w| write(mesh, format, w))
 }
 
 #[cfg(test)]

@@ -4,9 +4,9 @@
 use super::{repair, RepairOptions, RepairReport};
 use crate::check::{check, read_file, CheckOptions, CheckReport, Defects, Verdict};
 use crate::error::{Error, Result};
+use crate::io::sink::MeshFile;
 use crate::io::{Format, ReadOptions, Reading};
 use crate::progress::Progress;
-use crate::sink::MeshFile;
 use std::path::Path;
 
 /// Everything `latvox repair` reports.

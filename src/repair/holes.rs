@@ -7,9 +7,9 @@
 use super::cgal;
 use crate::error::Result;
 use crate::field::Vec3;
+use crate::mesh::topology::BoundaryLoop;
+use crate::mesh::triangulate::{newell_normal, triangulate_polygon};
 use crate::mesh::{dot, norm, sub, Mesh};
-use crate::topology::BoundaryLoop;
-use crate::triangulate::{newell_normal, triangulate_polygon};
 
 /// A loop is planar when no vertex is farther than this fraction of its bounding-box diagonal
 /// from its best plane.

@@ -23,9 +23,9 @@ mod split;
 
 use crate::check::{self, zero_area};
 use crate::error::Result;
+use crate::mesh::topology::Topology;
 use crate::mesh::{cross, dot, sub, Mesh};
 use crate::progress::Progress;
-use crate::topology::Topology;
 use rayon::prelude::*;
 
 pub use file::{repair_file, FileRepairReport};
@@ -352,7 +352,7 @@ fn stitch(w: &mut Work, tol: f64) -> u64 {
     for e in 0..topo.edge_count() {
         let hs = topo.edge(e);
         if hs.len() == 1 {
-            let (a, b) = crate::topology::half_edge(mesh, hs[0]);
+            let (a, b) = crate::mesh::topology::half_edge(mesh, hs[0]);
             bv.push(a);
             bv.push(b);
         }
@@ -424,7 +424,7 @@ fn orient_outward(w: &mut Work) -> u64 {
     for e in 0..topo.edge_count() {
         let hs = topo.edge(e);
         let s = shell_of[(hs[0] / 3) as usize] as usize;
-        let he = |h: u32| crate::topology::half_edge(mesh, h);
+        let he = |h: u32| crate::mesh::topology::half_edge(mesh, h);
         if hs.len() != 2 || he(hs[0]) == he(hs[1]) {
             closed[s] = false;
         }

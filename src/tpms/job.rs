@@ -1,22 +1,22 @@
 //! One TPMS job, start to finish: check the request, calibrate a first level, find the level
 //! that gives *this* part its density (raising the resolution when the voxels are too coarse to
-//! reach it), mesh, verify, write and report — the meshing itself is [`crate::pipeline`]'s.
+//! reach it), mesh, verify, write and report — the meshing itself is [`crate::mesh::pipeline`]'s.
 
 use super::calibrate::{self, Calibration, Connectivity, FeasibleRange};
 use super::{Domain, Lattice, LatticeFamily, MeshingStats, Structure, Surface};
+use crate::check::cgal::Verification;
 use crate::check::Verdict;
 use crate::error::{Error, Result};
 use crate::field::Aabb;
-use crate::instance;
+use crate::io::sink::{MeshCollector, MeshSink};
+use crate::mesh::instance;
+use crate::mesh::pieces::Fragments;
+use crate::mesh::pipeline::{self, Options, Route, Solved, PROMISE};
 use crate::mesh::Mesh;
-use crate::pieces::Fragments;
-use crate::pipeline::{self, Options, Route, Solved, PROMISE};
 use crate::progress::Progress;
-use crate::sink::{MeshCollector, MeshSink};
-use crate::verify::Verification;
 use std::time::Instant;
 
-pub use crate::pipeline::{Instancing, Tiling, DEFAULT_MEMORY};
+pub use crate::mesh::pipeline::{Instancing, Tiling, DEFAULT_MEMORY};
 
 /// Sheet walls thinner than this many voxels are not represented faithfully by a narrow band
 /// (samples miss the wall and it perforates); the resolution is raised to keep them this thick.

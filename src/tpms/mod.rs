@@ -1,7 +1,7 @@
 //! TPMS lattices: a surface, a structure, a target volume fraction and a box, to a closed mesh
 //! whose volume fraction is the target.
 //!
-//! Pipeline: [`calibrate`] the level on the unit cell (a first guess) → [`crate::pipeline`]:
+//! Pipeline: [`calibrate`] the level on the unit cell (a first guess) → [`crate::mesh::pipeline`]:
 //! sample the lattice clipped by its box into an OpenVDB narrow band, mesh, snap, measure the
 //! part and correct the level until its density is the target, verify with CGAL, write.
 //!
@@ -19,10 +19,10 @@ pub use surface::{Structure, Surface, TpmsField};
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
+use crate::mesh::pipeline::{mesh_keyed, Family, Solid};
 use crate::mesh::Mesh;
-use crate::pipeline::{mesh_keyed, Family, Solid};
 
-pub use crate::pipeline::{MeshingStats, HALF_WIDTH};
+pub use crate::mesh::pipeline::{MeshingStats, HALF_WIDTH};
 
 /// A TPMS lattice clipped by a box: everything needed to mesh it, at a known level.
 #[derive(Debug, Clone, Copy)]

@@ -8,10 +8,10 @@
 //! the largest volume is the part, and every other outer shell, with the cavities lying within
 //! its bounds, is a fragment.
 
-use crate::extract::KeyedMesh;
 use crate::field::Aabb;
+use crate::mesh::extract::KeyedMesh;
+use crate::mesh::topology::UnionFind;
 use crate::mesh::{cross, dot};
-use crate::topology::UnionFind;
 
 /// Fragments found (and removed, unless kept) in a mesh.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]

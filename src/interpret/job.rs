@@ -7,10 +7,10 @@ use super::contour::{self, Loop};
 use super::{extrude, volume, Density};
 use crate::cad::bspline::Periodic;
 use crate::cad::fit;
+use crate::check::cgal::{verify, Verification};
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::progress::Progress;
-use crate::verify::{verify, Verification};
 use rayon::prelude::*;
 use std::time::Instant;
 

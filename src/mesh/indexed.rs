@@ -1,7 +1,7 @@
-//! Mesh: indexed triangles, wound counter-clockwise seen from outside, in millimetres.
+//! The mesh type: indexed triangles, wound counter-clockwise seen from outside, in millimetres.
 //!
 //! Measures here (volume by the divergence theorem, area, bounds, edge incidence) are latvox's
-//! own; `verify` re-measures with CGAL, independently.
+//! own; [`crate::check::cgal`] re-measures with CGAL, independently.
 
 use crate::field::{Aabb, Vec3};
 

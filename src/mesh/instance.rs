@@ -32,12 +32,12 @@
 //! template*, [`measuring_plan`]); fragments the box cuts loose are found on the template too.
 
 use crate::error::{Error, Result};
-use crate::extract::{KeyedMesh, VertexKey};
 use crate::field::{Aabb, Vec3};
 use crate::grid::GridSpec;
-use crate::pieces::{Fragments, Shells};
-use crate::pipeline::{MeshingStats, Solid};
-use crate::sink::{Measures, MeshSink, Triangle};
+use crate::io::sink::{Measures, MeshSink, Triangle};
+use crate::mesh::extract::{KeyedMesh, VertexKey};
+use crate::mesh::pieces::{Fragments, Shells};
+use crate::mesh::pipeline::{MeshingStats, Solid};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -161,8 +161,8 @@ impl Template {
             .ok_or_else(|| Error::invalid("a template needs a periodic solid"))?;
         let tb = template_bounds(&solid.bounds(), cell, &plan);
         let small = solid.with_bounds(tb);
-        let spec = GridSpec::covering(&tb, h, crate::pipeline::HALF_WIDTH);
-        let (mut mesh, stats) = crate::pipeline::mesh_keyed(&small, spec, None, 0.0, None)?;
+        let spec = GridSpec::covering(&tb, h, crate::mesh::pipeline::HALF_WIDTH);
+        let (mut mesh, stats) = crate::mesh::pipeline::mesh_keyed(&small, spec, None, 0.0, None)?;
         let m = plan.map(|a| a.m as usize);
         let mut fragments_by_cell = vec![(0u64, 0.0f64); m[0] * m[1] * m[2]];
         let mut fragment_keys = std::collections::HashSet::new();
@@ -194,7 +194,7 @@ impl Template {
                     .iter()
                     .map(|&s| shells.kept[s as usize])
                     .collect();
-                crate::pieces::retain(&mut mesh, &keep);
+                crate::mesh::pieces::retain(&mut mesh, &keep);
             }
         }
         let mut t = Template::from_mesh(mesh, cell, plan)?;

@@ -11,6 +11,7 @@
 //! edge counted in one class. Self-intersections are counted by CGAL among the facets that are
 //! neither degenerate nor duplicates (those are counted on their own).
 
+pub mod cgal;
 mod file;
 pub(crate) mod verdict;
 
@@ -19,8 +20,8 @@ pub use verdict::Verdict;
 
 use crate::error::Result;
 use crate::field::Vec3;
+use crate::mesh::topology::{half_edge, Topology};
 use crate::mesh::{cross, dot, norm, sub, Mesh};
-use crate::topology::{half_edge, Topology};
 use rayon::prelude::*;
 
 /// A facet whose area is below this fraction of its longest edge squared is degenerate

@@ -112,7 +112,7 @@ pub struct StlSink {
 impl StlSink {
     /// Opens the temporary file (the destination folder must be writable).
     pub fn create(path: &Path, format: StlFormat) -> Result<StlSink> {
-        let tmp = crate::output::temp_beside(path)?;
+        let tmp = crate::io::atomic::temp_beside(path)?;
         let file = tmp.reopen().map_err(|e| Error::io(path, e))?;
         Ok(StlSink {
             path: path.to_path_buf(),
@@ -315,7 +315,7 @@ impl ThreeMfSink {
             rewound(self.triangles).map_err(io)?,
         );
         let body = v.metadata().map_err(io)?.len() + t.metadata().map_err(io)?.len();
-        let tmp = crate::output::temp_beside(&path)?;
+        let tmp = crate::io::atomic::temp_beside(&path)?;
         let file = std::io::BufWriter::with_capacity(1 << 20, tmp.reopen().map_err(io)?);
         let mut zip = zip::ZipWriter::new(file);
         let opts = zip::write::SimpleFileOptions::default()
@@ -420,7 +420,7 @@ impl MeshFile {
 
     /// Writes `mesh` to the file atomically, its vertices indexed as they are.
     pub fn save(&self, mesh: &Mesh) -> Result<()> {
-        crate::output::write_atomic(&self.path, |w| {
+        crate::io::atomic::write_atomic(&self.path, |w| {
             crate::io::write(mesh, self.format, self.ascii, w)
         })
     }

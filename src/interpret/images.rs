@@ -30,7 +30,7 @@ impl Canvas {
     }
 
     fn save(&self, path: &Path) -> Result<()> {
-        crate::output::write_atomic(path, |w| {
+        crate::io::atomic::write_atomic(path, |w| {
             let mut e = png::Encoder::new(w, self.w as u32, self.h as u32);
             e.set_color(png::ColorType::Rgb);
             e.set_depth(png::BitDepth::Eight);

@@ -16,9 +16,9 @@
 //! [`MAX_TURN_DEGREES`] is found and its vertices are returned to OpenVDB's positions, repeatedly,
 //! until none is.
 
-use crate::extract::{position, KeyedMesh};
 use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
+use crate::mesh::extract::{position, KeyedMesh};
 use rayon::prelude::*;
 
 /// What the snap pass did, for the report.

@@ -3,9 +3,9 @@
 //!
 //! The grid's samples are cut into cubic tiles of whole 8³ blocks. Each tile is sampled with a
 //! margin of [`MARGIN`] samples on every side, meshed by OpenVDB, and snapped, exactly as the whole
-//! part would be ([`crate::extract`] names every vertex by its voxel and edge group and computes
+//! part would be ([`crate::mesh::extract`] names every vertex by its voxel and edge group and computes
 //! its position from that name alone; snapping moves a vertex by its own data, and its fold
-//! repair looks no further than [`crate::snap::UNFOLD_PASSES`] rings, well inside the margin). A
+//! repair looks no further than [`crate::mesh::snap::UNFOLD_PASSES`] rings, well inside the margin). A
 //! tile keeps the quads whose edge starts in it, so every quad is written by exactly one tile,
 //! with the same corners, bit for bit, as in the untiled mesh: seams are welded exactly and the
 //! tiled part is the same solid, triangle for triangle.
@@ -15,9 +15,9 @@
 //! way, and CGAL's self-intersection test runs on the kept triangles with their neighbours.
 
 use crate::error::Result;
-use crate::extract::KeyedMesh;
 use crate::grid::IndexBox;
-use crate::sink::{Measures, MeshSink, Triangle};
+use crate::io::sink::{Measures, MeshSink, Triangle};
+use crate::mesh::extract::KeyedMesh;
 use rayon::prelude::*;
 use std::collections::HashMap;
 

@@ -15,7 +15,6 @@ pub mod extrude;
 pub mod features;
 pub mod images;
 pub mod job;
-pub mod npy;
 pub mod raster;
 pub mod skeleton;
 pub mod volume;

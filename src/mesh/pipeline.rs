@@ -5,8 +5,8 @@
 //! level `t`, a strut radius, …) that thickens the solid as it grows. The pipeline then:
 //!
 //! 1. **routes** the part ([`Route`]): copied cell by cell from a meshed template when the solid
-//!    is periodic and the cells span whole OpenVDB leaves ([`crate::instance`]), meshed in tiles
-//!    when its grid would not fit the memory budget ([`crate::tile`]), or meshed whole;
+//!    is periodic and the cells span whole OpenVDB leaves ([`crate::mesh::instance`]), meshed in tiles
+//!    when its grid would not fit the memory budget ([`crate::mesh::tile`]), or meshed whole;
 //! 2. **finds the level on the part itself** ([`solve`]): the part is meshed (or, for large
 //!    periodic parts, a template of its cells is — [`Template::part_volume`] gives the whole
 //!    part's volume from it), its loose fragments removed, its volume fraction measured, and
@@ -21,18 +21,18 @@
 //! [`solve`] says so with the closest fraction it found, and the caller raises the resolution
 //! or refuses.
 
+use crate::check::cgal::{verify, verify_on, Verification};
 use crate::error::{Error, Result};
-use crate::extract::KeyedMesh;
 use crate::field::{Aabb, Field, Intersection, Vec3};
 use crate::grid::{Grid, GridSpec, IndexBox};
-use crate::instance::{self, AxisPlan, Template};
+use crate::io::sink::{Measures, MeshSink, Triangle};
+use crate::mesh::extract::KeyedMesh;
+use crate::mesh::instance::{self, AxisPlan, Template};
+use crate::mesh::pieces::{self, Fragments};
+use crate::mesh::snap::SnapStats;
+use crate::mesh::tile;
 use crate::mesh::Mesh;
-use crate::pieces::{self, Fragments};
 use crate::progress::Progress;
-use crate::sink::{Measures, MeshSink, Triangle};
-use crate::snap::SnapStats;
-use crate::tile;
-use crate::verify::{verify, verify_on, Verification};
 use std::time::Instant;
 
 /// Default narrow-band half width, voxels.
@@ -150,7 +150,7 @@ pub fn mesh_keyed<S: Solid + ?Sized>(
     };
     drop(grid);
     let t = Instant::now();
-    let snap = crate::snap::snap_within(&mut keyed, &*field, &bounds, &spec, snap_within);
+    let snap = crate::mesh::snap::snap_within(&mut keyed, &*field, &bounds, &spec, snap_within);
     Ok((
         keyed,
         MeshingStats {
@@ -471,7 +471,7 @@ pub struct Written {
     pub write_seconds: f64,
 }
 
-/// How the part was meshed when it was copied from a template (see [`crate::instance`]).
+/// How the part was meshed when it was copied from a template (see [`crate::mesh::instance`]).
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Instancing {
     /// Cells of the part per axis that the template stands for (1 along axes not copied).
@@ -484,7 +484,7 @@ pub struct Instancing {
     pub verified: &'static str,
 }
 
-/// How the part was meshed when it was meshed in tiles (see [`crate::tile`]).
+/// How the part was meshed when it was meshed in tiles (see [`crate::mesh::tile`]).
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Tiling {
     pub tiles: u64,

@@ -221,7 +221,7 @@ fn spur(nx: usize, ny: usize, skel: &[bool], radius: &[f64], e: usize) -> Option
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::topo::distance::edt_squared;
+    use crate::interpret::distance::edt_squared;
 
     fn rect(nx: usize, ny: usize, x0: usize, x1: usize, y0: usize, y1: usize) -> Vec<bool> {
         (0..nx * ny)

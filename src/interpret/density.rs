@@ -5,8 +5,8 @@
 //! a 2D array has shape `(ny, nx)` with row 0 at the **top**; a 3D array `(ny, nx, nz)`.
 //! In memory a [`Density`] is stored x fastest, then y **upwards**, then z.
 
-use super::npy;
 use crate::error::{Error, Result};
+use crate::io::npy;
 use std::path::Path;
 
 /// A regular grid of element densities in [0, 1].

@@ -1,0 +1,20 @@
+//! Meshes: the triangle mesh and what makes one from a grid and gets it out.
+//!
+//! [`indexed`] is the mesh type and its measures; [`extract`] meshes a level set with every
+//! vertex named by its voxel and edge group, [`snap`] moves the vertices onto the exact surface,
+//! [`tile`] and [`instance`] mesh large parts in pieces that weld exactly, [`pieces`] finds the
+//! fragments a box cuts loose, and [`pipeline`] puts them together: any clipped field to a
+//! verified mesh at its target density, streamed to a sink. [`topology`] and [`triangulate`]
+//! serve the checks and the readers.
+
+pub mod extract;
+mod indexed;
+pub mod instance;
+pub mod pieces;
+pub mod pipeline;
+pub mod snap;
+pub mod tile;
+pub mod topology;
+pub mod triangulate;
+
+pub use indexed::*;
