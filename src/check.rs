@@ -1,7 +1,7 @@
-//! Mesh check: every defect of seed 001 (and the ones admesh misses) found and counted, overall
-//! and per shell.
+//! Mesh check: every STL defect of Qiao Q., "Key technologies of rapid prototyping from 3D STL
+//! models" (and the ones admesh misses) found and counted, overall and per shell.
 //!
-//! A valid STL solid (seed 001): every edge in exactly two facets, traversed once in each
+//! A valid STL solid (that paper's rules): every edge in exactly two facets, traversed once in each
 //! direction; neighbours share whole edges (no T-junctions); each facet's stored normal agrees with
 //! its winding by the right-hand rule; every shell closed, wound outward (a cavity inward, by
 //! nesting parity); no degenerate or duplicate facets; no self-intersections. Per shell the

@@ -4,7 +4,8 @@
 //!
 //! Stages, one module each: [`field`] → [`grid`] → [`extract`] → [`mesh`] → [`verify`] →
 //! [`io`] / [`sink`] (files).
-//! Capabilities: [`tpms`], [`check`] and [`repair`] (any mesh file, seed 001's defects),
+//! Capabilities: [`tpms`], [`check`] and [`repair`] (any mesh file; the STL defects of
+//! Qiao Q., "Key technologies of rapid prototyping from 3D STL models"),
 //! [`topopt`] (SIMP optimiser), [`topo`] (density fields to STL and CAD), [`cad`] (B-spline
 //! curves, IGES, DXF), [`batch`] (many jobs, resumable, sharded over Slurm arrays).
 

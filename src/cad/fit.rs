@@ -1,5 +1,5 @@
-//! Fitting boundary loops with closed cubic B-splines to a max-deviation tolerance (seed 003,
-//! step 3):
+//! Fitting boundary loops with closed cubic B-splines to a max-deviation tolerance (Liu et al.
+//! 2018, step 3):
 //! - **uniform** (step 3.1): equally spaced knots; the fewest control points that meet the
 //!   tolerance, found by bisection on the count;
 //! - **adaptive** (step 3.2): knots where the curve's character changes. From the uniform fit,

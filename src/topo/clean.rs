@@ -1,14 +1,14 @@
-//! The repair loop of seed 003 (steps 1–2): threshold and refine, find thin features, islands
-//! and point contacts; then raise the density of what is too thin by 0.1, filter, re-threshold
-//! at the level that keeps the thresholded volume, and look again — until nothing is left or the
-//! iteration bound is reached (reported, never hidden).
+//! The repair loop of Liu et al. 2018 (steps 1–2): threshold and refine, find thin features,
+//! islands and point contacts; then raise the density of what is too thin by 0.1, filter,
+//! re-threshold at the level that keeps the thresholded volume, and look again — until nothing is
+//! left or the iteration bound is reached (reported, never hidden).
 //!
 //! What gets raised: the pixels within `max(l_limit, filter radius) / 2` of each thin-feature
 //! pixel, of each point contact, of each medial pixel of the thresholded design that vanished
-//! (the loop preserves the design's members: seed 003's "feature-preserving" refinement), and
-//! of the shortest path from each island to the main body (a bridge). Islands smaller than
-//! one element are removed; larger ones farther than `l_limit` plus one element are left and
-//! reported.
+//! (the loop preserves the design's members: the paper's "feature-preserving" boundary
+//! refinement), and of the shortest path from each island to the main body (a bridge). Islands
+//! smaller than one element are removed; larger ones farther than `l_limit` plus one element are
+//! left and reported.
 
 use super::distance::edt_squared;
 use super::features::{analyse, face_neighbours, Analysis};
@@ -17,7 +17,7 @@ use super::Density;
 use crate::error::{Error, Result};
 use std::collections::VecDeque;
 
-/// The seed's parameters, with its defaults.
+/// The cleanup's parameters; the defaults are Liu et al. 2018's.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct CleanOptions {
     /// ρcutoff of step 1.1.

@@ -1,6 +1,6 @@
 //! What makes a thresholded density field unprintable, found on the refined grid:
-//! - **thin features** (seed 003, step 1.3): in 2D, skeleton pixels whose inscribed radius is
-//!   below `l_limit / 2` (to within half a pixel); in 3D, solid voxels that no ball of radius `l_limit / 2` inside the
+//! - **thin features** (Liu et al. 2018, step 1.3): in 2D, skeleton pixels whose inscribed radius
+//!   is below `l_limit / 2` (to within half a pixel); in 3D, solid voxels that no ball of radius `l_limit / 2` inside the
 //!   solid covers (the residue of a morphological opening computed with distance transforms),
 //!   ignoring the thin rim such an opening always leaves along convex edges and corners;
 //! - **islands**: solid parts not face-connected to the main (largest) body;

@@ -1,6 +1,6 @@
-//! The whole `topo` job on one density field: clean (seed 003 steps 1–2), mesh (2D: extrude the
-//! boundary loops; 3D: OpenVDB), verify with CGAL, and fit the CAD curves (2D, step 3). The CLI
-//! and the benchmarks call this; writing files is left to the caller.
+//! The whole `topo` job on one density field: clean (Liu et al. 2018, steps 1–2), mesh (2D:
+//! extrude the boundary loops; 3D: OpenVDB), verify with CGAL, and fit the CAD curves (2D,
+//! step 3). The CLI and the benchmarks call this; writing files is left to the caller.
 
 use super::clean::{clean, CleanOptions, Cleaned, Pass};
 use super::contour::{self, Loop};

@@ -1,5 +1,5 @@
 //! The refined grid the pipeline works on: every element split into `nc` (× `nc` × `nc` in 3D)
-//! pixels of the same density (seed 003, steps 1.1 and 2.1), the density filter of step 2.3
+//! pixels of the same density (Liu et al. 2018, steps 1.1 and 2.1), the density filter of step 2.3
 //! and the volume-keeping threshold of step 2.4.
 
 use super::Density;

@@ -198,7 +198,8 @@ pub fn builtin(name: &str, dims: Option<[usize; 3]>) -> Result<Problem> {
             p.fixed.push(2 * p.nodes() - 1);
             p.loads = vec![(1, -1.0)];
         }
-        // Seed 003's cantilever: left edge clamped, unit load down at the lower right corner.
+        // Liu et al. 2018's cantilever: left edge clamped, unit load down at the lower right
+        // corner.
         "cantilever" => {
             p.fixed = (0..2 * (nely + 1)).collect();
             p.loads = vec![(2 * p.node(nelx, 0, 0) + 1, -1.0)];

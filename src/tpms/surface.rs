@@ -468,7 +468,7 @@ impl Field for TpmsField {
 mod tests {
     use super::*;
 
-    /// The seed's formulas, written out directly, as an independent reference.
+    /// The published formulas (period 1), written out directly, as an independent reference.
     fn reference(s: Surface, u: Vec3) -> f64 {
         let (x, y, z) = (TAU * u[0], TAU * u[1], TAU * u[2]);
         let (c, sn) = (f64::cos, f64::sin);
