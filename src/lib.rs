@@ -9,6 +9,8 @@
 //! [`topopt`] (SIMP optimiser), [`topo`] (density fields to STL and CAD), [`cad`] (B-spline
 //! curves, IGES, DXF), [`batch`] (many jobs, resumable, sharded over Slurm arrays).
 
+#![warn(missing_docs)]
+
 pub mod batch;
 pub mod cad;
 pub mod check;

@@ -18,6 +18,7 @@ use rayon::prelude::*;
 /// A fitted loop.
 #[derive(Debug, Clone)]
 pub struct Fitted {
+    /// The fitted closed B-spline.
     pub curve: Periodic,
     /// Largest distance from a boundary point to the curve, mm.
     pub max_deviation: f64,

@@ -30,6 +30,7 @@ pub struct CleanOptions {
     pub filter_radius: f64,
     /// Density added to thin features per iteration (step 2.2).
     pub raise: f64,
+    /// Passes of the loop at most; defects left after the last are reported.
     pub max_iterations: usize,
 }
 
@@ -49,15 +50,21 @@ impl Default for CleanOptions {
 /// Counts after one pass of the loop.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Pass {
+    /// Pass number, from 1.
     pub iteration: usize,
     /// Threshold level that keeps the volume.
     pub level: f64,
+    /// Solid pixels (voxels in 3D) after the pass.
     pub solid_pixels: usize,
+    /// Thin-feature pixels left.
     pub thin_pixels: usize,
+    /// Islands left.
     pub islands: usize,
+    /// Point contacts left.
     pub point_contacts: usize,
     /// Medial pixels of the thresholded design no longer covered (vanished members).
     pub lost_pixels: usize,
+    /// Islands removed before this pass's filtering.
     pub islands_removed: usize,
 }
 
@@ -71,15 +78,20 @@ pub struct Cleaned {
     pub initial: Analysis,
     /// The final filtered field and its level.
     pub field: Raster,
+    /// The final level.
     pub level: f64,
+    /// The final solid: the filtered field thresholded at `level`.
     pub mask: Mask,
+    /// The defects found on the final solid.
     pub last: Analysis,
     /// Solid pixels of the thresholded field: the volume the loop keeps.
     pub target_pixels: usize,
+    /// Counts after each pass, in order.
     pub passes: Vec<Pass>,
 }
 
 impl Cleaned {
+    /// Whether the final solid has no defect left.
     pub fn is_clean(&self) -> bool {
         self.last.is_clean()
     }

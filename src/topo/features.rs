@@ -27,10 +27,12 @@ pub struct Analysis {
     /// Medial pixels of the thresholded design (its members' centre lines) that this mask has
     /// lost: a member that vanished instead of being thickened.
     pub lost: Vec<usize>,
+    /// Solid pixels (voxels in 3D) of the mask.
     pub solid: usize,
 }
 
 impl Analysis {
+    /// Whether no defect was found: no thin feature, island, point contact or lost member.
     pub fn is_clean(&self) -> bool {
         self.thin.is_empty()
             && self.islands.is_empty()

@@ -17,7 +17,9 @@ use rayon::prelude::*;
 
 /// The iso-surface `ρ = level` of a 3D raster.
 pub struct DensityField<'a> {
+    /// The densities, one per voxel.
     pub grid: &'a Raster,
+    /// The density at the surface.
     pub level: f64,
     /// Largest density (raised features may exceed 1): the gradient bound scales with it.
     pub top: f64,
@@ -135,9 +137,13 @@ pub fn mesh(grid: &Raster, level: f64) -> Result<Mesh> {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Smoothing {
+    /// Gaussian filter of the level set (OpenVDB's `gaussian`).
     Gaussian,
+    /// Mean-curvature flow (`meanCurvature`).
     MeanCurvature,
+    /// Laplacian flow (`laplacian`).
     Laplacian,
+    /// Mean (box) filter (`mean`).
     Mean,
 }
 
@@ -150,6 +156,7 @@ pub struct Smoothed {
 }
 
 impl Smoothed {
+    /// Builds the level set of `grid`'s iso-surface at `level` and smooths it.
     pub fn new(grid: &Raster, level: f64, mode: Smoothing, iterations: u32) -> Result<Smoothed> {
         let top = grid.data.iter().copied().fold(1.0f64, f64::max);
         let f = DensityField { grid, level, top };

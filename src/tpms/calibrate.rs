@@ -332,7 +332,9 @@ fn one_percolating_component(vals: &[f64], n: usize, member: &dyn Fn(f64) -> boo
 /// The volume fractions a surface and structure can take with both phases connected.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct FeasibleRange {
+    /// Smallest feasible volume fraction.
     pub min: f64,
+    /// Largest feasible volume fraction.
     pub max: f64,
 }
 
@@ -408,6 +410,7 @@ pub fn percolation_range(
 /// The calibrated level and how it was found.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Calibration {
+    /// The level `t` found for the target fraction.
     pub level: f64,
     /// Level from the exact unit cell alone.
     pub analytic_level: f64,
@@ -422,6 +425,7 @@ pub struct Calibration {
     /// Whether the meshed cell's fraction came within reach of the target (on voxels too
     /// coarse for the lattice's members it jumps past it).
     pub converged: bool,
+    /// Wall time of the calibration, seconds.
     pub seconds: f64,
 }
 
