@@ -342,7 +342,7 @@ fn tiled_volume<S: Solid>(solid: &S, voxel: f64, edge: i64) -> Result<(f64, Mesh
             .add(&s);
         Ok(m)
     };
-    let mut sink = VolumeSink::default();
+    let mut sink = VolumeSink;
     let out = tile::mesh_tiled(spec.padded_region(), edge, &mesh_tile, false, &mut sink)?;
     Ok((
         out.measures.volume,
