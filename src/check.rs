@@ -423,7 +423,7 @@ pub fn winding_number(mesh: &Mesh, facets: &[u32], p: Vec3) -> f64 {
 const PROBES: usize = 16;
 
 /// Nesting depth of each closed shell: how many other closed shells contain it (its bounding
-/// box, and every one of up to [`PROBES`] points spread over its surface). `closed[s]` selects the shells taken into account; others get `None`.
+/// box, and every one of up to `PROBES` points spread over its surface). `closed[s]` selects the shells taken into account; others get `None`.
 pub fn nesting(mesh: &Mesh, members: &[Vec<u32>], closed: &[bool]) -> Vec<Option<u32>> {
     let bounds: Vec<Option<(Vec3, Vec3)>> = members
         .iter()

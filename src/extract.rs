@@ -2,7 +2,7 @@
 //!
 //! OpenVDB's volumeToMesh (at adaptivity 0) puts one point in each voxel per *edge group* — per
 //! separate piece of surface crossing the voxel — and one quad across every sign-changing edge
-//! between samples, joining the points of the four voxels around it. [`Grid::extract`] recovers
+//! between samples, joining the points of the four voxels around it. `Grid::extract` recovers
 //! for each point its voxel and edge group, so a vertex is named by a [`VertexKey`] that does not
 //! depend on which grid it was meshed in, and each quad by the primal edge it crosses. Vertex
 //! positions are computed here from the key alone (voxel corner + OpenVDB's in-voxel average of

@@ -156,7 +156,7 @@ struct Chunk {
 }
 
 /// Welds a triangle soup of `facets` facets, `facet(f)` giving the corners of each, in
-/// parallel: corners are dealt to [`SHARDS`] shards by the hash of their position's bits
+/// parallel: corners are dealt to `SHARDS` shards by the hash of their position's bits
 /// (partitioned chunk by chunk, so every pass reads and writes memory in order), each shard
 /// welds its own with a hash map small enough to stay in cache, and the shards' vertices are
 /// numbered one shard after another, each shard's in the order of their first corners

@@ -7,7 +7,7 @@
 //!
 //! Stages, one module each: [`density`] (input) → [`raster`] (threshold, refine, density
 //! filter, volume-keeping level) → [`skeleton`] and [`distance`] (feature size) →
-//! [`features`] (thin features, islands, point contacts) → [`clean`] (the repair loop) →
+//! [`features`] (thin features, islands, point contacts) → [`mod@clean`] (the repair loop) →
 //! [`contour`] (boundary loops) → [`extrude`] (2D) or [`volume`] (3D, OpenVDB) → STL;
 //! [`images`] draws every stage; `crate::cad` fits and writes the curves.
 

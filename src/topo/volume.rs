@@ -1,5 +1,5 @@
 //! 3D results to a mesh through latvox's own pipeline (optionally smoothed by OpenVDB's
-//! level-set filter, [`smoothed_mesh`]): the filtered density grid is a
+//! level-set filter, [`Smoothed`]): the filtered density grid is a
 //! [`Field`] (trilinear between voxel centres, void beyond the domain), sampled into an OpenVDB
 //! narrow-band level set by [`Grid::sample`] and meshed by [`Grid::to_mesh`].
 //!

@@ -10,7 +10,7 @@
 //! 2. **Mesh level.** Meshing a surface on voxels changes its volume slightly (chords across
 //!    curved surfaces, sub-voxel features). The unit cell is meshed at the part's own voxel size
 //!    and phase twice, side by side: once with a margin of neighbouring cells, measuring the
-//!    volume inside the cell only ([`Mesh::volume_in_box`]) — what every interior cell of the
+//!    volume inside the cell only ([`crate::mesh::Mesh::volume_in_box`]) — what every interior cell of the
 //!    part contributes — and once clipped by its own box, whose difference from the first is the
 //!    effect of a cut face. A part of `nx × ny × nz` cells is predicted as
 //!    `interior + (1/nx + 1/ny + 1/nz)/3 · face`. The difference between that prediction and the
@@ -339,8 +339,8 @@ pub struct FeasibleRange {
 }
 
 /// Scans and bisects the solid's connectivity for the ends of the feasible range around the
-/// middle of the fraction range. Slow (hundreds of percolation tests): [`FEASIBLE`] holds its
-/// results, and a test recomputes them.
+/// middle of the fraction range. Slow (hundreds of percolation tests): a table holds its
+/// results ([`feasible`]), and a test recomputes them.
 pub fn feasible_range(surface: Surface, structure: Structure) -> FeasibleRange {
     percolation_range(surface, structure, NC, false)
 }
