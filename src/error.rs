@@ -11,13 +11,20 @@ pub enum Error {
     /// A file could not be read or written.
     #[error("{path}: {source}")]
     Io {
+        /// The file.
         path: PathBuf,
+        /// What the operating system said.
         #[source]
         source: std::io::Error,
     },
     /// A file was read but its contents are not what its format promises.
     #[error("{path}: {message}")]
-    Format { path: PathBuf, message: String },
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with its contents.
+        message: String,
+    },
     /// Bytes (or text) given to a parser are not what their format promises; the parser does not
     /// know the file they came from ([`Error::in_file`] names it).
     #[error("{0}")]
@@ -25,12 +32,15 @@ pub enum Error {
     /// OpenVDB or CGAL threw.
     #[error("{context}: {message}")]
     Backend {
+        /// The operation that failed.
         context: &'static str,
+        /// The exception's message.
         message: String,
     },
 }
 
 impl Error {
+    /// A request that cannot be done (exit code 2).
     pub fn invalid(msg: impl Into<String>) -> Self {
         Error::Invalid(msg.into())
     }
@@ -52,6 +62,7 @@ impl Error {
         }
     }
 
+    /// A file that could not be read or written.
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {
             path: path.into(),
@@ -75,4 +86,5 @@ impl Error {
     }
 }
 
+/// latvox's result: [`Error`] unless said otherwise.
 pub type Result<T, E = Error> = std::result::Result<T, E>;

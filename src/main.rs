@@ -48,7 +48,8 @@ enum Command {
     /// SIMP topology optimisation (88-line code in 2D, top3d in 3D): densities to .npy.
     #[command(after_help = cli::topopt::EXAMPLES)]
     Topopt(cli::topopt::TopoptArgs),
-    /// Density field to printable STL and parametric CAD (IGES, DXF): seed 003's pipeline.
+    /// Density field to printable STL and parametric CAD (IGES, DXF): feature-preserving cleanup
+    /// and adaptive B-spline fitting (Liu et al., Engineering 2018).
     #[command(after_help = cli::topo::EXAMPLES)]
     Topo(cli::topo::TopoArgs),
     /// Run many jobs from a TOML job file: sweeps, workers, resume after a kill, Slurm arrays.

@@ -21,6 +21,7 @@ impl Progress {
         }
     }
 
+    /// No progress shown (library use, tests, batch workers).
     pub fn hidden() -> Self {
         Progress { enabled: false }
     }

@@ -33,10 +33,15 @@ use std::path::{Path, PathBuf};
 /// One option value, as the job file gives it.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Value {
+    /// A string.
     Str(String),
+    /// An integer.
     Int(i64),
+    /// A floating-point number.
     Float(f64),
+    /// A boolean (a flag).
     Bool(bool),
+    /// A list, one value on the command line (comma-separated).
     List(Vec<Value>),
 }
 
@@ -110,8 +115,11 @@ impl Job {
 /// A parsed job file: its folder (every relative path is relative to it) and its jobs.
 #[derive(Debug, Clone)]
 pub struct JobFile {
+    /// The job file, as given.
     pub path: PathBuf,
+    /// Its folder (`.` when the path has none).
     pub dir: PathBuf,
+    /// The jobs, sweeps expanded, in batch order.
     pub jobs: Vec<Job>,
 }
 

@@ -5,7 +5,7 @@
 //!   its output, its report and a stable hash of its parameters.
 //! - [`shard`]: `--shard K/N` and the Slurm array environment → which jobs this process runs.
 //! - [`resume`]: the record each job leaves in its report, and the test that a job is done.
-//! - [`run`]: the worker pool; a job's outputs and then its report are written atomically.
+//! - [`mod@run`]: the worker pool; a job's outputs and then its report are written atomically.
 //! - [`summary`]: the per-job summary, CSV and JSON.
 //!
 //! The batch does not know how to make a part: each job is a [`Task`] built by the CLI from the

@@ -50,15 +50,20 @@ pub enum Outcome {
 /// An output file and its size when the job finished.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct FileRecord {
+    /// Relative to the job file's folder.
     pub path: String,
+    /// Size in bytes.
     pub bytes: u64,
 }
 
 /// The Slurm job a batch job ran under.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct SlurmIds {
+    /// `SLURM_JOB_ID`.
     pub job_id: Option<String>,
+    /// `SLURM_ARRAY_JOB_ID`, under a job array.
     pub array_job_id: Option<String>,
+    /// `SLURM_ARRAY_TASK_ID`, under a job array.
     pub array_task_id: Option<String>,
 }
 
@@ -80,22 +85,35 @@ impl SlurmIds {
 pub struct Provenance {
     /// Number of the job in the batch, from 1.
     pub job: usize,
+    /// Where the job comes from in the job file: `job 3` or `sweep 1, variant 5`.
     pub origin: String,
+    /// The parameter hash ([`job_hash`]): the job's identity for resuming.
     pub hash: String,
+    /// The latvox subcommand.
     pub command: String,
+    /// The subcommand's options as the job file gives them.
     pub options: serde_json::Value,
+    /// How the run ended.
     pub outcome: Outcome,
     /// Unique to this execution of the job: a job that is skipped keeps its old run id.
     pub run_id: String,
     /// RFC 3339, UTC.
     pub started: String,
+    /// RFC 3339, UTC.
     pub finished: String,
+    /// Wall time of the job, seconds.
     pub seconds: f64,
+    /// The machine's name ([`host_name`]).
     pub host: String,
+    /// Process id of the batch that ran it.
     pub pid: u32,
+    /// Version of the latvox that ran it.
     pub latvox_version: String,
+    /// `K/N` when the batch ran as a shard.
     pub shard: Option<String>,
+    /// The Slurm job, when run under Slurm.
     pub slurm: Option<SlurmIds>,
+    /// Each output file and its size when the job finished.
     pub outputs: Vec<FileRecord>,
 }
 

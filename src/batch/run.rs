@@ -30,6 +30,7 @@ pub struct TaskReport {
     pub report: serde_json::Value,
     /// Whether the part passed the subcommand's own checks.
     pub passed: bool,
+    /// Warnings the subcommand gave (the summary counts them).
     pub warnings: Vec<String>,
 }
 
@@ -48,8 +49,11 @@ pub struct Settings {
 pub enum Event<'a> {
     /// Jobs of this shard, how many are already done, how many will run.
     Begin {
+        /// Jobs in this shard.
         jobs: usize,
+        /// Of them, already done (skipped).
         skipped: usize,
+        /// Of them, to run now.
         to_run: usize,
     },
     /// A job ran (or failed).
@@ -59,10 +63,12 @@ pub enum Event<'a> {
 /// A job as a dry run lists it: where it comes from, what it writes, and whether it is done.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct PlannedJob {
+    /// Which job, and the files it writes.
     #[serde(flatten)]
     pub name: JobName,
     /// A previous run is still valid (and `force` is off): running the batch skips it.
     pub done: bool,
+    /// The subcommand's options, as the job file gives them.
     pub options: serde_json::Value,
 }
 

@@ -15,6 +15,7 @@ use crate::error::{Error, Result};
 pub struct Shard {
     /// From 0.
     pub index: usize,
+    /// The number of shards N (at least 1).
     pub count: usize,
 }
 

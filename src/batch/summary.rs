@@ -21,6 +21,7 @@ pub enum Status {
 }
 
 impl Status {
+    /// The status as the summary writes it: `ok`, `skipped`, `defects` or `failed`.
     pub fn name(self) -> &'static str {
         match self {
             Status::Ok => "ok",
@@ -36,10 +37,15 @@ impl Status {
 pub struct JobName {
     /// Number of the job in the batch, from 1.
     pub job: usize,
+    /// Where the job comes from in the job file: `job 3` or `sweep 1, variant 5`.
     pub origin: String,
+    /// The latvox subcommand.
     pub command: String,
+    /// The output, relative to the job file's folder.
     pub output: String,
+    /// The JSON report, relative to the job file's folder.
     pub report: String,
+    /// The parameter hash: the job's identity for resuming.
     pub hash: String,
 }
 
@@ -59,14 +65,18 @@ impl From<&Job> for JobName {
 /// One row of the summary.
 #[derive(Debug, Clone, Serialize)]
 pub struct JobResult {
+    /// Which job.
     #[serde(flatten)]
     pub name: JobName,
+    /// What happened to it.
     pub status: Status,
     /// Wall time of this run of the job (0 when skipped).
     pub seconds: f64,
     /// The run that made the outputs: this one, or for a skipped job the earlier one.
     pub run_id: Option<String>,
+    /// Warnings the subcommand gave.
     pub warnings: usize,
+    /// The error, when the job failed.
     pub error: Option<String>,
 }
 
@@ -86,9 +96,13 @@ impl JobResult {
 /// Jobs by status.
 #[derive(Debug, Clone, Copy, Default, Serialize)]
 pub struct Counts {
+    /// Jobs that ran and passed their checks.
     pub ok: usize,
+    /// Jobs done by an earlier run, not run again.
     pub skipped: usize,
+    /// Jobs whose checks found defects.
     pub defects: usize,
+    /// Jobs that stopped with an error.
     pub failed: usize,
 }
 
@@ -110,14 +124,19 @@ impl Counts {
 /// The whole run.
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
+    /// The job file, as given.
     pub job_file: String,
     /// Jobs in the whole batch (all shards).
     pub jobs_in_batch: usize,
+    /// `K/N` when this run is one shard of the batch.
     pub shard: Option<String>,
+    /// Jobs running at once.
     pub workers: usize,
     /// RFC 3339, UTC.
     pub started: String,
+    /// Wall time of the whole run, seconds.
     pub seconds: f64,
+    /// Jobs of this shard by status.
     pub counts: Counts,
     /// This shard's jobs, by job number.
     pub jobs: Vec<JobResult>,
@@ -129,10 +148,12 @@ impl Summary {
         self.counts.failed == 0 && self.counts.defects == 0
     }
 
+    /// Writes the summary as JSON, atomically.
     pub fn write_json(&self, path: &Path) -> Result<()> {
         crate::io::atomic::write_json(path, self)
     }
 
+    /// Writes the summary as CSV (one row per job, a header first), atomically.
     pub fn write_csv(&self, path: &Path) -> Result<()> {
         crate::io::atomic::write_atomic(path, |w| {
             writeln!(

@@ -11,6 +11,7 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 
+/// A point (x, y) in the plane.
 pub type P2 = [f64; 2];
 
 /// A closed cubic B-spline.
@@ -18,7 +19,9 @@ pub type P2 = [f64; 2];
 pub struct Periodic {
     /// Knots in `[0, period)`, strictly increasing.
     pub knots: Vec<f64>,
+    /// Parameter period `L`: one turn around the curve (the points' chord length when fitted).
     pub period: f64,
+    /// Control points, one per knot.
     pub points: Vec<P2>,
     /// `t_k` for `k = −4 … m + 4`, at `ext[k + 4]` (evaluation reads knots a lot).
     ext: Vec<f64>,
@@ -39,10 +42,12 @@ impl Periodic {
         }
     }
 
+    /// Number of control points (as many as knots).
     pub fn len(&self) -> usize {
         self.points.len()
     }
 
+    /// Whether the curve has no control points.
     pub fn is_empty(&self) -> bool {
         self.points.is_empty()
     }
@@ -72,6 +77,7 @@ impl Periodic {
         (j0 + q * m as isize, n)
     }
 
+    /// The point at parameter `u` (any real; the curve repeats with the period).
     pub fn eval(&self, u: f64) -> P2 {
         let m = self.points.len() as isize;
         let (j, n) = self.basis(u);

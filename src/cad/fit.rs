@@ -1,5 +1,5 @@
-//! Fitting boundary loops with closed cubic B-splines to a max-deviation tolerance (seed 003,
-//! step 3):
+//! Fitting boundary loops with closed cubic B-splines to a max-deviation tolerance (Liu et al.
+//! 2018, step 3):
 //! - **uniform** (step 3.1): equally spaced knots; the fewest control points that meet the
 //!   tolerance, found by bisection on the count;
 //! - **adaptive** (step 3.2): knots where the curve's character changes. From the uniform fit,
@@ -18,6 +18,7 @@ use rayon::prelude::*;
 /// A fitted loop.
 #[derive(Debug, Clone)]
 pub struct Fitted {
+    /// The fitted closed B-spline.
     pub curve: Periodic,
     /// Largest distance from a boundary point to the curve, mm.
     pub max_deviation: f64,

@@ -24,9 +24,13 @@ pub struct Verification {
     pub volume: Option<f64>,
     /// Surface area, mm².
     pub area: f64,
+    /// Faces of CGAL's mesh.
     pub faces: u64,
+    /// Vertices of CGAL's mesh.
     pub vertices: u64,
+    /// Edges with only one face.
     pub border_edges: u64,
+    /// Connected components.
     pub components: u64,
 }
 

@@ -31,17 +31,22 @@ impl serde::Serialize for Defects {
 pub struct FileCheckReport {
     /// The file, as named.
     pub file: String,
+    /// The file's format, as read.
     pub format: Format,
     /// latvox's and CGAL's findings together (in JSON, the one flag `valid_solid`).
     #[serde(rename = "valid_solid", serialize_with = "super::verdict::valid_solid")]
     pub verdict: Verdict,
+    /// Triangles after reading (polygons split).
     pub triangles: u64,
+    /// Vertices after welding.
     pub vertices: u64,
     /// The edge counts of the check, in the shape of [`crate::mesh::Mesh::edge_stats`].
     pub edges: EdgeStats,
+    /// What reading did to the file (faces skipped, polygons split, vertices merged).
     pub reading: Reading,
     /// latvox's own checks.
     pub check: CheckReport,
+    /// The defect classes found, with their counts.
     pub defects: Defects,
     /// CGAL's checks (its self-intersection finding is the one `check` made).
     pub cgal: Verification,

@@ -1,7 +1,7 @@
-//! Mesh check: every defect of seed 001 (and the ones admesh misses) found and counted, overall
-//! and per shell.
+//! Mesh check: every STL defect of Qiao Q., "Key technologies of rapid prototyping from 3D STL
+//! models" (and the ones admesh misses) found and counted, overall and per shell.
 //!
-//! A valid STL solid (seed 001): every edge in exactly two facets, traversed once in each
+//! A valid STL solid (that paper's rules): every edge in exactly two facets, traversed once in each
 //! direction; neighbours share whole edges (no T-junctions); each facet's stored normal agrees with
 //! its winding by the right-hand rule; every shell closed, wound outward (a cavity inward, by
 //! nesting parity); no degenerate or duplicate facets; no self-intersections. Per shell the
@@ -68,18 +68,27 @@ pub enum Orientation {
 /// One shell (facets connected through shared edges).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ShellReport {
+    /// Facets in the shell.
     pub facets: u64,
+    /// Vertices the shell's facets use.
     pub vertices: u64,
+    /// Distinct edges of the shell.
     pub edges: u64,
+    /// Edges with only one facet.
     pub boundary_edges: u64,
+    /// Edges shared by three or more facets.
     pub non_manifold_edges: u64,
+    /// Closed loops of boundary edges (holes).
     pub hole_loops: u64,
+    /// No boundary or non-manifold edge.
     pub closed: bool,
+    /// How the shell is wound.
     pub orientation: Orientation,
     /// Can be wound consistently at all (false for a Möbius-like shell).
     pub orientable: bool,
     /// Signed volume by the divergence theorem, mm³ (meaningful when closed).
     pub volume: f64,
+    /// Surface area, mm².
     pub area: f64,
     /// V − E + F.
     pub euler: i64,
@@ -94,6 +103,7 @@ pub struct ShellReport {
 /// Stored normals compared with the winding (STL only).
 #[derive(Debug, Clone, Copy, Default, serde::Serialize)]
 pub struct NormalReport {
+    /// Facets whose stored normal was compared (degenerate facets are left out).
     pub checked: u64,
     /// Pointing into the opposite half-space.
     pub reversed: u64,
@@ -106,24 +116,35 @@ pub struct NormalReport {
 /// Everything `latvox check` reports.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct CheckReport {
+    /// Facets in the mesh.
     pub facets: u64,
     /// Vertices used by some facet.
     pub vertices: u64,
+    /// Vertices no facet uses.
     pub unreferenced_vertices: u64,
+    /// Distinct edges.
     pub edges: u64,
+    /// Shells: facets connected through shared edges.
     pub shell_count: u64,
+    /// Edges with only one facet.
     pub boundary_edges: u64,
     /// Closed loops of boundary edges (holes).
     pub hole_loops: u64,
     /// Boundary chains that do not close (at non-manifold vertices).
     pub open_boundary_chains: u64,
+    /// Edges shared by three or more facets.
     pub non_manifold_edges: u64,
+    /// Vertices where two or more fans of facets meet only at the vertex.
     pub non_manifold_vertices: u64,
     /// Edges whose two facets traverse them in the same direction.
     pub inconsistent_edges: u64,
+    /// Closed shells facing into the material.
     pub inward_shells: u64,
+    /// Shells that cannot be wound consistently.
     pub non_orientable_shells: u64,
+    /// Facets with the same vertex twice.
     pub repeated_vertex_facets: u64,
+    /// Facets with three distinct vertices and (numerically) zero area ([`zero_area`]).
     pub zero_area_facets: u64,
     /// Extra copies of a facet (same three vertices, either winding).
     pub duplicate_facets: u64,
@@ -137,10 +158,12 @@ pub struct CheckReport {
     pub self_intersection_examples: Vec<(u32, u32)>,
     /// Sum of the shells' signed volumes, mm³.
     pub volume: f64,
+    /// Sum of the shells' areas, mm².
     pub area: f64,
     /// A valid closed, outward, self-intersection-free solid with sound normals: this report's
     /// [`Verdict`].
     pub valid_solid: bool,
+    /// Every shell, in the order the shells are numbered.
     pub shells: Vec<ShellReport>,
 }
 
@@ -239,6 +262,7 @@ pub fn duplicate_facets(mesh: &Mesh, topo: &Topology) -> Vec<u32> {
 pub struct TJunction {
     /// The half-edge (`3f + k`) whose interior holds the vertex.
     pub half_edge: u32,
+    /// The vertex lying inside the half-edge.
     pub vertex: u32,
     /// Position along the half-edge, in (0, 1).
     pub t: f64,
@@ -400,7 +424,7 @@ pub fn winding_number(mesh: &Mesh, facets: &[u32], p: Vec3) -> f64 {
 const PROBES: usize = 16;
 
 /// Nesting depth of each closed shell: how many other closed shells contain it (its bounding
-/// box, and every one of up to [`PROBES`] points spread over its surface). `closed[s]` selects the shells taken into account; others get `None`.
+/// box, and every one of up to `PROBES` points spread over its surface). `closed[s]` selects the shells taken into account; others get `None`.
 pub fn nesting(mesh: &Mesh, members: &[Vec<u32>], closed: &[bool]) -> Vec<Option<u32>> {
     let bounds: Vec<Option<(Vec3, Vec3)>> = members
         .iter()

@@ -1,4 +1,5 @@
-//! `latvox topo`: a density field to a printable STL and parametric CAD (seed 003).
+//! `latvox topo`: a density field to a printable STL and parametric CAD (feature-preserving
+//! cleanup and adaptive B-spline fitting, after Liu et al. 2018).
 
 use super::out::outln;
 use super::{cgal_findings, write_json};
@@ -12,7 +13,7 @@ use std::path::PathBuf;
 
 pub(crate) const EXAMPLES: &str = "\
 Examples:
-  # Seed 003's cantilever: 30 × 10 elements of 4 mm, 2 mm printer limit, 4 mm thick plate
+  # Liu et al. 2018's cantilever: 30 × 10 elements of 4 mm, 2 mm printer limit, 4 mm thick plate
   latvox topo cantilever.npy --element-size 4 --cutoff 0.5 --refine 8 --min-feature 2 \\
       --thickness 4 -o part.stl --iges part.igs --dxf part.dxf --report r.json --images stages
 
@@ -26,15 +27,18 @@ Input: .npy (float, int or bool; C or Fortran order), .csv (2D, one row per line
 dimension header line `ny nx [nz]` then the values. 2D arrays are (ny, nx) with row 0 at the
 top, as the 88-line code's xPhys; 3D arrays (ny, nx, nz), as top3d's. Densities in [0, 1].
 
-The pipeline (seed 003): threshold at --cutoff and refine every element into --refine pixels
-per edge; skeleton with spur pruning, inscribed radius = local feature size (3D: distance
-transforms); thin features (radius < min-feature/2), islands and point contacts are raised by
-0.1, density-filtered (radius --filter-radius elements) and re-thresholded at the level that
-keeps the thresholded volume, until none is left (at most --max-iterations passes).
-2D results are extruded by --thickness; 3D results are meshed by OpenVDB (optionally smoothed
-with its level-set filter, --smooth), at the level that keeps the thresholded volume. Every mesh is checked
-by CGAL. The CAD curves (2D) are closed cubic B-splines within --tolerance of the boundary,
-uniform and adaptive; the IGES and DXF files hold the adaptive ones.
+The pipeline is the feature-preserving cleanup and adaptive B-spline fitting of Liu S. et al.,
+\"A realization method for transforming a topology optimization design into additive
+manufacturing structures\", Engineering 4(2), 2018: threshold at --cutoff and refine every
+element into --refine pixels per edge; skeleton with spur pruning, inscribed radius = local
+feature size (3D: distance transforms); thin features (radius < min-feature/2), islands and
+point contacts are raised by 0.1, density-filtered (radius --filter-radius elements) and
+re-thresholded at the level that keeps the thresholded volume, until none is left (at most
+--max-iterations passes). 2D results are extruded by --thickness; 3D results are meshed by
+OpenVDB (optionally smoothed with its level-set filter, --smooth), at the level that keeps the
+thresholded volume. Every mesh is checked by CGAL. The CAD curves (2D) are closed cubic
+B-splines within --tolerance of the boundary, uniform and adaptive; the IGES and DXF files hold
+the adaptive ones.
 
 Exit code 0: clean and valid; 1: defects remain after the last pass or a mesh check failed;
 2: bad input or arguments.";

@@ -14,7 +14,7 @@ Examples:
   latvox topopt --problem mbb --nelx 60 --nely 20 --volfrac 0.5 --penal 3 --rmin 1.5 \\
       --filter sensitivity -o mbb.npy --report mbb.json
 
-  # Seed 003's cantilever (120 × 40 mm on 30 × 10 elements), then to STL and CAD
+  # Liu et al. 2018's cantilever (120 × 40 mm on 30 × 10 elements), then to STL and CAD
   latvox topopt --problem cantilever --volfrac 0.3 -o cantilever.npy
   latvox topo cantilever.npy --element-size 4 --thickness 4 -o cantilever.stl --iges c.igs
 

@@ -68,11 +68,14 @@ impl<T: Field + ?Sized> Field for &T {
 /// An axis-aligned box `[min, max]`, as an exact signed distance field.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Aabb {
+    /// Lower corner, mm.
     pub min: Vec3,
+    /// Upper corner, mm.
     pub max: Vec3,
 }
 
 impl Aabb {
+    /// Edge lengths along x, y, z, mm.
     pub fn size(&self) -> Vec3 {
         [
             self.max[0] - self.min[0],
@@ -81,11 +84,13 @@ impl Aabb {
         ]
     }
 
+    /// Volume, mm³.
     pub fn volume(&self) -> f64 {
         let s = self.size();
         s[0] * s[1] * s[2]
     }
 
+    /// Whether `p` lies in the box (faces included).
     pub fn contains(&self, p: Vec3) -> bool {
         (0..3).all(|a| p[a] >= self.min[a] && p[a] <= self.max[a])
     }
@@ -122,7 +127,9 @@ impl Field for Aabb {
 
 /// The intersection of two solids (`max` of the values). The clip of a lattice by its box.
 pub struct Intersection<A, B> {
+    /// The first solid.
     pub a: A,
+    /// The second solid.
     pub b: B,
 }
 

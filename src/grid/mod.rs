@@ -58,6 +58,7 @@ impl GridSpec {
         .to_blocks()
     }
 
+    /// The centre of sample `i`, mm.
     pub fn point(&self, i: [i64; 3]) -> Vec3 {
         [0, 1, 2].map(|a| self.origin[a] + (i[a] as f64 + 0.5) * self.voxel)
     }
@@ -66,11 +67,14 @@ impl GridSpec {
 /// A box of sample indices, `lo` inclusive, `hi` exclusive.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct IndexBox {
+    /// First sample index per axis (inclusive).
     pub lo: [i64; 3],
+    /// One past the last sample index per axis.
     pub hi: [i64; 3],
 }
 
 impl IndexBox {
+    /// Whether sample `i` lies in the box.
     pub fn contains(&self, i: [i64; 3]) -> bool {
         (0..3).all(|a| i[a] >= self.lo[a] && i[a] < self.hi[a])
     }
@@ -83,6 +87,7 @@ impl IndexBox {
         }
     }
 
+    /// Number of samples in the box (0 when empty).
     pub fn voxels(&self) -> u64 {
         (0..3)
             .map(|a| (self.hi[a] - self.lo[a]).max(0) as u64)
@@ -106,12 +111,14 @@ pub const MIN_ABS_VALUE_VOXELS: f64 = 1.0 / 64.0;
 /// A sparse narrow-band level set held by OpenVDB.
 pub struct Grid {
     inner: cxx::UniquePtr<ffi::VdbGrid>,
+    /// Where and how finely the grid was sampled.
     pub spec: GridSpec,
     /// Global sample index of the OpenVDB grid's index (0, 0, 0). OpenVDB sees indices relative
     /// to it, so its coordinates stay small however far the grid lies from the part's origin.
     pub frame: [i64; 3],
-    /// Leaf blocks that were tested, and that were sampled.
+    /// Leaf blocks tested against the field's clearance.
     pub blocks_tested: u64,
+    /// Leaf blocks sampled (those the band reached).
     pub blocks_sampled: u64,
 }
 
@@ -223,14 +230,17 @@ impl Grid {
         Ok(Mesh { positions, indices })
     }
 
+    /// Active voxels (OpenVDB's count: the narrow band).
     pub fn active_voxels(&self) -> u64 {
         ffi::vdb_active_voxels(&self.inner)
     }
 
+    /// Leaf nodes (8³ blocks) OpenVDB holds.
     pub fn leaf_count(&self) -> u64 {
         ffi::vdb_leaf_count(&self.inner)
     }
 
+    /// Memory OpenVDB reports for the grid, bytes.
     pub fn memory_bytes(&self) -> u64 {
         ffi::vdb_memory_bytes(&self.inner)
     }

@@ -1,14 +1,14 @@
-//! The repair loop of seed 003 (steps 1–2): threshold and refine, find thin features, islands
-//! and point contacts; then raise the density of what is too thin by 0.1, filter, re-threshold
-//! at the level that keeps the thresholded volume, and look again — until nothing is left or the
-//! iteration bound is reached (reported, never hidden).
+//! The repair loop of Liu et al. 2018 (steps 1–2): threshold and refine, find thin features,
+//! islands and point contacts; then raise the density of what is too thin by 0.1, filter,
+//! re-threshold at the level that keeps the thresholded volume, and look again — until nothing is
+//! left or the iteration bound is reached (reported, never hidden).
 //!
 //! What gets raised: the pixels within `max(l_limit, filter radius) / 2` of each thin-feature
 //! pixel, of each point contact, of each medial pixel of the thresholded design that vanished
-//! (the loop preserves the design's members: seed 003's "feature-preserving" refinement), and
-//! of the shortest path from each island to the main body (a bridge). Islands smaller than
-//! one element are removed; larger ones farther than `l_limit` plus one element are left and
-//! reported.
+//! (the loop preserves the design's members: the paper's "feature-preserving" boundary
+//! refinement), and of the shortest path from each island to the main body (a bridge). Islands
+//! smaller than one element are removed; larger ones farther than `l_limit` plus one element are
+//! left and reported.
 
 use super::distance::edt_squared;
 use super::features::{analyse, face_neighbours, Analysis};
@@ -17,7 +17,7 @@ use super::Density;
 use crate::error::{Error, Result};
 use std::collections::VecDeque;
 
-/// The seed's parameters, with its defaults.
+/// The cleanup's parameters; the defaults are Liu et al. 2018's.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct CleanOptions {
     /// ρcutoff of step 1.1.
@@ -30,6 +30,7 @@ pub struct CleanOptions {
     pub filter_radius: f64,
     /// Density added to thin features per iteration (step 2.2).
     pub raise: f64,
+    /// Passes of the loop at most; defects left after the last are reported.
     pub max_iterations: usize,
 }
 
@@ -49,15 +50,21 @@ impl Default for CleanOptions {
 /// Counts after one pass of the loop.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Pass {
+    /// Pass number, from 1.
     pub iteration: usize,
     /// Threshold level that keeps the volume.
     pub level: f64,
+    /// Solid pixels (voxels in 3D) after the pass.
     pub solid_pixels: usize,
+    /// Thin-feature pixels left.
     pub thin_pixels: usize,
+    /// Islands left.
     pub islands: usize,
+    /// Point contacts left.
     pub point_contacts: usize,
     /// Medial pixels of the thresholded design no longer covered (vanished members).
     pub lost_pixels: usize,
+    /// Islands removed before this pass's filtering.
     pub islands_removed: usize,
 }
 
@@ -71,15 +78,20 @@ pub struct Cleaned {
     pub initial: Analysis,
     /// The final filtered field and its level.
     pub field: Raster,
+    /// The final level.
     pub level: f64,
+    /// The final solid: the filtered field thresholded at `level`.
     pub mask: Mask,
+    /// The defects found on the final solid.
     pub last: Analysis,
     /// Solid pixels of the thresholded field: the volume the loop keeps.
     pub target_pixels: usize,
+    /// Counts after each pass, in order.
     pub passes: Vec<Pass>,
 }
 
 impl Cleaned {
+    /// Whether the final solid has no defect left.
     pub fn is_clean(&self) -> bool {
         self.last.is_clean()
     }

@@ -12,10 +12,13 @@ use std::path::Path;
 /// A regular grid of element densities in [0, 1].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Density {
+    /// Elements along x.
     pub nx: usize,
+    /// Elements along y.
     pub ny: usize,
     /// 1 for a 2D field.
     pub nz: usize,
+    /// Whether the input array was 3D.
     pub is_3d: bool,
     /// `data[(iz·ny + iy)·nx + ix]`, `iy` from the bottom.
     pub data: Vec<f64>,
@@ -24,6 +27,7 @@ pub struct Density {
 }
 
 impl Density {
+    /// Density of element `(ix, iy, iz)`, `iy` from the bottom.
     pub fn at(&self, ix: usize, iy: usize, iz: usize) -> f64 {
         self.data[(iz * self.ny + iy) * self.nx + ix]
     }

@@ -1,6 +1,6 @@
 //! What makes a thresholded density field unprintable, found on the refined grid:
-//! - **thin features** (seed 003, step 1.3): in 2D, skeleton pixels whose inscribed radius is
-//!   below `l_limit / 2` (to within half a pixel); in 3D, solid voxels that no ball of radius `l_limit / 2` inside the
+//! - **thin features** (Liu et al. 2018, step 1.3): in 2D, skeleton pixels whose inscribed radius
+//!   is below `l_limit / 2` (to within half a pixel); in 3D, solid voxels that no ball of radius `l_limit / 2` inside the
 //!   solid covers (the residue of a morphological opening computed with distance transforms),
 //!   ignoring the thin rim such an opening always leaves along convex edges and corners;
 //! - **islands**: solid parts not face-connected to the main (largest) body;
@@ -27,10 +27,12 @@ pub struct Analysis {
     /// Medial pixels of the thresholded design (its members' centre lines) that this mask has
     /// lost: a member that vanished instead of being thickened.
     pub lost: Vec<usize>,
+    /// Solid pixels (voxels in 3D) of the mask.
     pub solid: usize,
 }
 
 impl Analysis {
+    /// Whether no defect was found: no thin feature, island, point contact or lost member.
     pub fn is_clean(&self) -> bool {
         self.thin.is_empty()
             && self.islands.is_empty()

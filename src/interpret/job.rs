@@ -1,6 +1,6 @@
-//! The whole `topo` job on one density field: clean (seed 003 steps 1–2), mesh (2D: extrude the
-//! boundary loops; 3D: OpenVDB), verify with CGAL, and fit the CAD curves (2D, step 3). The CLI
-//! and the benchmarks call this; writing files is left to the caller.
+//! The whole `topo` job on one density field: clean (Liu et al. 2018, steps 1–2), mesh (2D:
+//! extrude the boundary loops; 3D: OpenVDB), verify with CGAL, and fit the CAD curves (2D,
+//! step 3). The CLI and the benchmarks call this; writing files is left to the caller.
 
 use super::clean::{clean, CleanOptions, Cleaned, Pass};
 use super::contour::{self, Loop};
@@ -17,6 +17,7 @@ use std::time::Instant;
 /// What to do besides cleaning.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct TopoJob {
+    /// The cleanup loop's options.
     pub clean: CleanOptions,
     /// Extrusion of a 2D field, mm.
     pub thickness: f64,
@@ -24,85 +25,128 @@ pub struct TopoJob {
     pub tolerance: f64,
     /// Fit the CAD curves (2D only).
     pub fit_curves: bool,
+    /// Run CGAL's self-intersection test (the costliest check).
     pub self_intersection: bool,
     /// 3D: OpenVDB level-set smoothing passes (0: none) and the flow.
     pub smooth_iterations: u32,
+    /// The level-set flow used for smoothing.
     pub smoothing: volume::Smoothing,
 }
 
 /// One boundary loop's fits.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct LoopFit {
+    /// Boundary points of the loop.
     pub points: usize,
     /// Counter-clockwise outer boundary (false: a hole).
     pub outer: bool,
+    /// Control points of the uniform fit.
     pub uniform_control_points: usize,
+    /// Its largest distance from a boundary point, mm.
     pub uniform_max_deviation: f64,
+    /// Control points of the adaptive fit.
     pub adaptive_control_points: usize,
+    /// Its largest distance from a boundary point, mm.
     pub adaptive_max_deviation: f64,
 }
 
+/// Wall time of each stage, seconds.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct Timings {
+    /// The cleanup loop.
     pub clean: f64,
+    /// Meshing (extrusion in 2D, OpenVDB in 3D).
     pub mesh: f64,
+    /// CGAL's checks.
     pub verify: f64,
+    /// Curve fitting.
     pub fit: f64,
+    /// The whole job.
     pub total: f64,
 }
 
 /// Defect counts of one analysed mask.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Defects {
+    /// Thin-feature pixels (voxels in 3D).
     pub thin_pixels: usize,
+    /// Islands: solid parts not face-connected to the main body.
     pub islands: usize,
+    /// Point contacts: solids touching only at a corner (or an edge, in 3D).
     pub point_contacts: usize,
     /// Smallest inscribed radius on the 2D skeleton, mm (`null` in 3D).
     pub min_radius: Option<f64>,
 }
 
+/// Everything `latvox topo` reports.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct TopoReport {
+    /// Elements along x, y, z (z = 0 for a 2D field).
     pub dims: [usize; 3],
+    /// Whether the field is 3D.
     pub is_3d: bool,
+    /// Element edge length, mm.
     pub element_size: f64,
+    /// The options the job ran with.
     pub job: TopoJob,
+    /// Pixel (voxel) edge length of the refined grid, mm.
     pub pixel_size: f64,
+    /// Pixels (voxels) of the refined grid along x, y, z.
     pub refined_dims: [usize; 3],
     /// Defects of the thresholded field (before the loop).
     pub initial: Defects,
     /// Defects left after the loop: all zero when `clean`.
     pub remaining: Defects,
+    /// No defect left after the loop.
     pub clean: bool,
+    /// Passes the loop took.
     pub iterations: usize,
+    /// Counts after each pass.
     pub passes: Vec<Pass>,
+    /// Level of the final solid (3D: the level meshed, moved to keep the volume).
     pub level: f64,
-    /// Solid volume (3D, mm³) or area (2D, mm²) of the thresholded field, the final pixels and
-    /// the final outline (2D: the loops' area; 3D: the mesh's volume as CGAL measures it).
+    /// Solid volume (3D, mm³) or area (2D, mm²) of the thresholded field: what the loop keeps.
     pub thresholded_measure: f64,
+    /// The same measure of the final pixels.
     pub final_pixel_measure: f64,
+    /// The same measure of the final outline (2D: the loops' area; 3D: the mesh's volume as
+    /// CGAL measures it).
     pub final_measure: f64,
     /// `final_measure / thresholded_measure − 1`.
     pub measure_change: f64,
+    /// Triangles of the mesh.
     pub triangles: usize,
+    /// Vertices of the mesh.
     pub vertices: usize,
+    /// CGAL's checks of the mesh.
     pub checks: Verification,
+    /// The mesh's volume as CGAL measures it, mm³ (`null` when it is not closed).
     pub mesh_volume: Option<f64>,
+    /// Each boundary loop's fits (2D with curve fitting).
     pub loops: Vec<LoopFit>,
+    /// Control points of the uniform fits, all loops.
     pub uniform_control_points: usize,
+    /// Control points of the adaptive fits, all loops.
     pub adaptive_control_points: usize,
     /// `adaptive / uniform` control points over all loops.
     pub control_point_ratio: Option<f64>,
+    /// Wall time of each stage.
     pub timings: Timings,
 }
 
 /// Results of [`run`].
 pub struct TopoResult {
+    /// The cleanup loop's results.
     pub cleaned: Cleaned,
+    /// The closed mesh (extruded in 2D, OpenVDB's in 3D).
     pub mesh: Mesh,
+    /// Boundary loops of the final solid, mm (2D; empty in 3D).
     pub loops: Vec<Loop>,
+    /// Uniform fit of each loop.
     pub uniform: Vec<Periodic>,
+    /// Adaptive fit of each loop (written to IGES and DXF).
     pub adaptive: Vec<Periodic>,
+    /// The report.
     pub report: TopoReport,
 }
 

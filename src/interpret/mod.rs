@@ -1,9 +1,13 @@
-//! `topo`: seed 003's path from an element density field to a printable, verified STL and a
-//! parametric B-spline CAD model.
+//! `topo`: from an element density field to a printable, verified STL and a parametric B-spline
+//! CAD model, by feature-preserving cleanup (skeleton-based thin-feature detection, density
+//! filtering) and curvature-adaptive B-spline fitting, after Liu S., Li Q., Liu J., Chen W.,
+//! Zhang Y., "A realization method for transforming a topology optimization design into additive
+//! manufacturing structures", Engineering 4(2), 277–285 (2018). Step numbers in this module's
+//! documentation are that paper's.
 //!
 //! Stages, one module each: [`density`] (input) → [`raster`] (threshold, refine, density
 //! filter, volume-keeping level) → [`skeleton`] and [`distance`] (feature size) →
-//! [`features`] (thin features, islands, point contacts) → [`clean`] (the repair loop) →
+//! [`features`] (thin features, islands, point contacts) → [`mod@clean`] (the repair loop) →
 //! [`contour`] (boundary loops) → [`extrude`] (2D) or [`volume`] (3D, OpenVDB) → STL;
 //! [`images`] draws every stage; `crate::cad` fits and writes the curves.
 

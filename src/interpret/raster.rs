@@ -1,5 +1,5 @@
 //! The refined grid the pipeline works on: every element split into `nc` (× `nc` × `nc` in 3D)
-//! pixels of the same density (seed 003, steps 1.1 and 2.1), the density filter of step 2.3
+//! pixels of the same density (Liu et al. 2018, steps 1.1 and 2.1), the density filter of step 2.3
 //! and the volume-keeping threshold of step 2.4.
 
 use super::Density;
@@ -8,9 +8,11 @@ use rayon::prelude::*;
 /// A 2D (`n[2] == 1`) or 3D grid of values, x fastest, then y (up), then z.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Raster {
+    /// Samples along x, y, z (`n[2] == 1` in 2D).
     pub n: [usize; 3],
     /// Pixel edge length, mm.
     pub h: f64,
+    /// The values, `data[index(x, y, z)]`.
     pub data: Vec<f64>,
 }
 
@@ -18,18 +20,22 @@ pub struct Raster {
 pub type Mask = Vec<bool>;
 
 impl Raster {
+    /// Whether the raster is 3D (more than one layer in z).
     pub fn is_3d(&self) -> bool {
         self.n[2] > 1
     }
 
+    /// Number of samples.
     pub fn len(&self) -> usize {
         self.data.len()
     }
 
+    /// Whether the raster has no samples.
     pub fn is_empty(&self) -> bool {
         self.data.is_empty()
     }
 
+    /// Position of sample `(x, y, z)` in `data`.
     pub fn index(&self, x: usize, y: usize, z: usize) -> usize {
         (z * self.n[1] + y) * self.n[0] + x
     }

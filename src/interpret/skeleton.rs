@@ -1,5 +1,5 @@
-//! Skeleton of a 2D solid (seed 003, step 1.2): Zhang–Suen thinning to a one-pixel medial curve,
-//! then spur pruning, as MATLAB's `bwmorph(…, 'skel')` and `'spur'` do for the seed.
+//! Skeleton of a 2D solid (Liu et al. 2018, step 1.2): Zhang–Suen thinning to a one-pixel medial
+//! curve, then spur pruning, as MATLAB's `bwmorph(…, 'skel')` and `'spur'` do in that paper.
 //!
 //! Thinning peels boundary pixels in two alternating sub-iterations, never breaking connectivity
 //! (a pixel goes only if its neighbours form a single run). Only pixels next to a deletion can

@@ -1,5 +1,5 @@
 //! 3D results to a mesh through latvox's own pipeline (optionally smoothed by OpenVDB's
-//! level-set filter, [`smoothed_mesh`]): the filtered density grid is a
+//! level-set filter, [`Smoothed`]): the filtered density grid is a
 //! [`Field`] (trilinear between voxel centres, void beyond the domain), sampled into an OpenVDB
 //! narrow-band level set by [`Grid::sample`] and meshed by [`Grid::to_mesh`].
 //!
@@ -17,7 +17,9 @@ use rayon::prelude::*;
 
 /// The iso-surface `ρ = level` of a 3D raster.
 pub struct DensityField<'a> {
+    /// The densities, one per voxel.
     pub grid: &'a Raster,
+    /// The density at the surface.
     pub level: f64,
     /// Largest density (raised features may exceed 1): the gradient bound scales with it.
     pub top: f64,
@@ -135,9 +137,13 @@ pub fn mesh(grid: &Raster, level: f64) -> Result<Mesh> {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Smoothing {
+    /// Gaussian filter of the level set (OpenVDB's `gaussian`).
     Gaussian,
+    /// Mean-curvature flow (`meanCurvature`).
     MeanCurvature,
+    /// Laplacian flow (`laplacian`).
     Laplacian,
+    /// Mean (box) filter (`mean`).
     Mean,
 }
 
@@ -150,6 +156,7 @@ pub struct Smoothed {
 }
 
 impl Smoothed {
+    /// Builds the level set of `grid`'s iso-surface at `level` and smooths it.
     pub fn new(grid: &Raster, level: f64, mode: Smoothing, iterations: u32) -> Result<Smoothed> {
         let top = grid.data.iter().copied().fold(1.0f64, f64::max);
         let f = DensityField { grid, level, top };

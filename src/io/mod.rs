@@ -28,10 +28,15 @@ pub use stl::StlFormat;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Format {
+    /// STL, binary or ASCII.
     Stl,
+    /// Wavefront OBJ.
     Obj,
+    /// Object File Format (OFF).
     Off,
+    /// Stanford PLY, ASCII or binary.
     Ply,
+    /// 3MF (3D Manufacturing Format), a zip package.
     #[serde(rename = "3mf")]
     ThreeMf,
 }
@@ -71,6 +76,7 @@ impl Format {
         }
     }
 
+    /// The format's usual name (`STL`, `3MF`, …).
     pub fn name(self) -> &'static str {
         match self {
             Format::Stl => "STL",
@@ -85,6 +91,7 @@ impl Format {
 /// What a reader produced.
 #[derive(Debug, Clone, Default)]
 pub struct Parsed {
+    /// The triangles read (polygons split, vertices welded exactly).
     pub mesh: Mesh,
     /// Per-facet normals as stored in the file (STL only; zero or NaN when the file had none).
     pub normals: Option<Vec<[f32; 3]>>,
@@ -104,10 +111,15 @@ pub struct ReadOptions {
 /// A file read into a mesh, with what reading did to it.
 #[derive(Debug, Clone)]
 pub struct Loaded {
+    /// The format read.
     pub format: Format,
+    /// The mesh, welded.
     pub mesh: Mesh,
+    /// Per-facet normals as stored in the file (STL only).
     pub normals: Option<Vec<[f32; 3]>>,
+    /// Faces with fewer than three corners, skipped.
     pub short_faces: u64,
+    /// Faces with more than three corners, cut into triangles.
     pub polygons_split: u64,
     /// Vertices merged by `weld_tolerance` (beyond exact welding).
     pub tolerance_welded: u64,
@@ -127,8 +139,11 @@ impl Loaded {
 /// What reading a file did to it, as reports give it (all zero for a clean file).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct Reading {
+    /// Faces with fewer than three corners, skipped.
     pub faces_with_fewer_than_3_corners_skipped: u64,
+    /// Faces with more than three corners, cut into triangles.
     pub polygons_split_into_triangles: u64,
+    /// Vertices merged by the weld tolerance (beyond exact welding).
     pub vertices_merged_by_tolerance: u64,
 }
 

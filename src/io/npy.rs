@@ -7,7 +7,9 @@ use std::io::Write;
 /// An n-dimensional array in C order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Array {
+    /// Length along each axis.
     pub shape: Vec<usize>,
+    /// The values, C order (last axis fastest).
     pub data: Vec<f64>,
 }
 

@@ -26,17 +26,22 @@ pub type Triangle = [[f32; 3]; 3];
 pub trait MeshSink {
     /// Called once before any triangle, with the total count when it is known in advance.
     fn begin(&mut self, triangles: Option<u64>) -> Result<()>;
+    /// Called with each batch of triangles, in order.
     fn triangles(&mut self, batch: &[Triangle]) -> Result<()>;
+    /// Called once after the last triangle.
     fn finish(&mut self) -> Result<()>;
 }
 
 /// Running measures of the triangles written so far.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Measures {
+    /// Triangles written.
     pub triangles: u64,
     /// Signed enclosed volume by the divergence theorem, mm³ (exact only for a closed mesh).
     pub volume: f64,
+    /// Surface area, mm².
     pub area: f64,
+    /// Bounding box of the corners written, mm.
     pub bounds: Aabb,
 }
 
@@ -85,6 +90,7 @@ impl Measures {
         }
     }
 
+    /// The measures of both sets of triangles together.
     pub fn merged(&self, o: &Measures) -> Measures {
         Measures {
             triangles: self.triangles + o.triangles,
@@ -240,6 +246,7 @@ impl MeshSink for StlSink {
 /// Gathers streamed triangles into an indexed mesh, welding bit-identical corners.
 #[derive(Default)]
 pub struct MeshCollector {
+    /// The mesh gathered so far.
     pub mesh: Mesh,
     weld: ExactIndex,
 }
@@ -378,7 +385,9 @@ impl MeshSink for ThreeMfSink {
 /// one place an output's format is chosen.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct MeshFile {
+    /// Where the file goes.
     pub path: PathBuf,
+    /// The format its extension names.
     pub format: Format,
     /// ASCII STL or ASCII PLY (binary otherwise; OBJ and OFF are text, 3MF a zip package).
     pub ascii: bool,
@@ -430,10 +439,15 @@ impl MeshFile {
 /// OBJ, OFF and PLY, which list each vertex once, gather the triangles (welding bit-identical
 /// corners, as [`MeshCollector`] does) and write them at [`FileSink::commit`].
 pub enum FileSink {
+    /// Binary or ASCII STL, streamed.
     Stl(StlSink),
+    /// 3MF, streamed.
     ThreeMf(ThreeMfSink),
+    /// OBJ, OFF or PLY: gathered, written at commit.
     Indexed {
+        /// The file to write.
         file: MeshFile,
+        /// The triangles gathered, welded.
         collector: MeshCollector,
     },
 }

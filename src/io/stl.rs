@@ -14,7 +14,9 @@ use std::path::Path;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum StlFormat {
+    /// Binary STL: an 80-byte header, a count, 50 bytes per facet.
     Binary,
+    /// ASCII STL (`solid` … `endsolid`).
     Ascii,
 }
 

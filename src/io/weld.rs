@@ -17,6 +17,7 @@ use std::hash::{BuildHasher, Hasher};
 #[derive(Default, Clone, Copy)]
 pub struct FastHash;
 
+/// The hasher [`FastHash`] builds.
 pub struct FastHasher(u64);
 
 impl BuildHasher for FastHash {
@@ -50,6 +51,7 @@ impl Hasher for FastHasher {
     }
 }
 
+/// A hash map with [`FastHash`].
 pub type FastMap<K, V> = HashMap<K, V, FastHash>;
 
 fn key(p: [f32; 3]) -> u128 {
@@ -74,6 +76,7 @@ impl ExactIndex {
         self.0.len()
     }
 
+    /// Whether no position has been seen.
     pub fn is_empty(&self) -> bool {
         self.0.is_empty()
     }
@@ -89,6 +92,7 @@ impl ExactIndex {
 /// Builds a mesh corner by corner, merging bit-identical positions.
 pub struct ExactWelder {
     index: ExactIndex,
+    /// The mesh built so far.
     pub mesh: Mesh,
     /// Corners seen (each `corner` call).
     pub corners: u64,
@@ -152,7 +156,7 @@ struct Chunk {
 }
 
 /// Welds a triangle soup of `facets` facets, `facet(f)` giving the corners of each, in
-/// parallel: corners are dealt to [`SHARDS`] shards by the hash of their position's bits
+/// parallel: corners are dealt to `SHARDS` shards by the hash of their position's bits
 /// (partitioned chunk by chunk, so every pass reads and writes memory in order), each shard
 /// welds its own with a hash map small enough to stay in cache, and the shards' vertices are
 /// numbered one shard after another, each shard's in the order of their first corners

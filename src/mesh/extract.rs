@@ -2,7 +2,7 @@
 //!
 //! OpenVDB's volumeToMesh (at adaptivity 0) puts one point in each voxel per *edge group* — per
 //! separate piece of surface crossing the voxel — and one quad across every sign-changing edge
-//! between samples, joining the points of the four voxels around it. [`Grid::extract`] recovers
+//! between samples, joining the points of the four voxels around it. `Grid::extract` recovers
 //! for each point its voxel and edge group, so a vertex is named by a [`VertexKey`] that does not
 //! depend on which grid it was meshed in, and each quad by the primal edge it crosses. Vertex
 //! positions are computed here from the key alone (voxel corner + OpenVDB's in-voxel average of
@@ -21,7 +21,9 @@ use rayon::prelude::*;
 /// which of the voxel's surface pieces it stands for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct VertexKey {
+    /// Sample index of the voxel's lower corner, in the spec's global indices.
     pub voxel: [i32; 3],
+    /// Which of the voxel's edge groups (surface pieces): OpenVDB's numbering.
     pub group: u8,
 }
 
@@ -30,6 +32,7 @@ pub struct VertexKey {
 /// triangles along the diagonal [`KeyedMesh::triangulate`] picks once the vertices have settled.
 #[derive(Debug, Clone, Default)]
 pub struct KeyedMesh {
+    /// Each vertex's key.
     pub keys: Vec<VertexKey>,
     /// Where each vertex is; [`KeyedMesh::extract`] fills in OpenVDB's point, `snap` moves it.
     pub positions: Vec<[f64; 3]>,
@@ -159,6 +162,7 @@ impl KeyedMesh {
         })
     }
 
+    /// Number of triangles the quads make (a stored triangle counts once).
     pub fn triangle_count(&self) -> usize {
         self.quads
             .iter()

@@ -8,13 +8,16 @@ use crate::field::{Aabb, Vec3};
 /// An indexed triangle mesh with flat storage (`positions` in xyz triples, `indices` in triples).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Mesh {
+    /// Vertex coordinates, mm: x, y, z of vertex `i` at `3i..3i + 3`.
     pub positions: Vec<f32>,
+    /// Vertex indices, three per triangle.
     pub indices: Vec<u32>,
 }
 
 /// Edge incidence counts: how many edges are bounded by one, two, or more triangles.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct EdgeStats {
+    /// Distinct edges (vertex pairs).
     pub edges: u64,
     /// Edges with exactly one incident triangle (holes).
     pub boundary: u64,
@@ -25,14 +28,17 @@ pub struct EdgeStats {
 }
 
 impl Mesh {
+    /// Number of vertices.
     pub fn vertex_count(&self) -> usize {
         self.positions.len() / 3
     }
 
+    /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }
 
+    /// Vertex `i`'s position, mm.
     pub fn vertex(&self, i: u32) -> Vec3 {
         let i = i as usize * 3;
         [
@@ -42,6 +48,7 @@ impl Mesh {
         ]
     }
 
+    /// The three corners of triangle `t`, mm.
     pub fn triangle(&self, t: usize) -> [Vec3; 3] {
         let i = &self.indices[3 * t..3 * t + 3];
         [self.vertex(i[0]), self.vertex(i[1]), self.vertex(i[2])]

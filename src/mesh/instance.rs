@@ -129,8 +129,11 @@ pub fn template_bounds(part: &Aabb, cell: Vec3, plan: &[AxisPlan; 3]) -> Aabb {
 
 /// A meshed template and what is needed to copy it.
 pub struct Template {
+    /// How each axis of the part maps onto the template.
     pub plan: [AxisPlan; 3],
+    /// The cell's edge lengths, mm.
     pub cell: Vec3,
+    /// The template's mesh, every vertex keyed by voxel and edge group.
     pub mesh: KeyedMesh,
     /// Template cell of each vertex.
     point_cell: Vec<[i8; 3]>,

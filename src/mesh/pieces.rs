@@ -79,9 +79,9 @@ impl Shells {
         }
         for (v, p) in mesh.positions.iter().enumerate() {
             let b = &mut bounds[of_vertex[v] as usize];
-            for a in 0..3 {
-                b.min[a] = b.min[a].min(p[a]);
-                b.max[a] = b.max[a].max(p[a]);
+            for (a, &x) in p.iter().enumerate() {
+                b.min[a] = b.min[a].min(x);
+                b.max[a] = b.max[a].max(x);
             }
         }
         let main = (0..count as usize).max_by(|&a, &b| volume[a].total_cmp(&volume[b]));
@@ -150,8 +150,8 @@ pub fn retain(mesh: &mut KeyedMesh, keep: &[bool]) {
         }
     }
     let mut w = 0;
-    for v in 0..keep.len() {
-        if keep[v] {
+    for (v, &k) in keep.iter().enumerate() {
+        if k {
             mesh.keys[w] = mesh.keys[v];
             mesh.positions[w] = mesh.positions[v];
             mesh.offsets[w] = mesh.offsets[v];

@@ -70,6 +70,7 @@ pub trait Solid: Sync {
 
 /// Solids indexed by a level; the solid grows with the level.
 pub trait Family: Sync {
+    /// The solid at one level.
     type Solid: Solid;
     /// The solid at `level`.
     fn at(&self, level: f64) -> Self::Solid;
@@ -83,14 +84,23 @@ pub trait Family: Sync {
 /// Statistics of meshing.
 #[derive(Debug, Clone, Copy, Default, serde::Serialize)]
 pub struct MeshingStats {
+    /// Voxel edge, mm.
     pub voxel_size: f64,
+    /// Leaf blocks tested against the field's clearance.
     pub blocks_tested: u64,
+    /// Leaf blocks sampled (those the narrow band reached).
     pub blocks_sampled: u64,
+    /// Active voxels of the grids (the narrow band).
     pub active_voxels: u64,
+    /// Memory of the largest grid, bytes (OpenVDB's count).
     pub grid_bytes: u64,
+    /// What snapping did to the vertices.
     pub snap: SnapStats,
+    /// Time spent sampling, seconds.
     pub sample_seconds: f64,
+    /// Time spent in OpenVDB's meshing, seconds.
     pub mesh_seconds: f64,
+    /// Time spent snapping, seconds.
     pub snap_seconds: f64,
 }
 
@@ -248,11 +258,15 @@ pub enum Made {
 
 /// A part meshed (or measured) at one level.
 pub struct Measured {
+    /// The level meshed.
     pub level: f64,
     /// Volume fraction of what will be written.
     pub fraction: f64,
+    /// What was meshed: the whole part, its template, or nothing held (tiles).
     pub made: Made,
+    /// Fragments the box cuts loose.
     pub fragments: Fragments,
+    /// Meshing statistics of this level.
     pub meshing: MeshingStats,
 }
 
@@ -328,7 +342,7 @@ fn tiled_volume<S: Solid>(solid: &S, voxel: f64, edge: i64) -> Result<(f64, Mesh
             .add(&s);
         Ok(m)
     };
-    let mut sink = VolumeSink::default();
+    let mut sink = VolumeSink;
     let out = tile::mesh_tiled(spec.padded_region(), edge, &mesh_tile, false, &mut sink)?;
     Ok((
         out.measures.volume,
@@ -360,6 +374,7 @@ pub struct Solved {
     pub tried: Vec<(f64, f64)>,
     /// Whether the fraction is within [`PROMISE`] of the target.
     pub met: bool,
+    /// Meshing statistics of every meshing the search took.
     pub meshing: MeshingStats,
 }
 
@@ -460,14 +475,23 @@ pub fn solve<F: Family>(
 
 /// Timings and checks of writing a part.
 pub struct Written {
+    /// CGAL's checks (on the template when copied; counted per tile when tiled).
     pub checks: Verification,
+    /// Meshing statistics.
     pub meshing: MeshingStats,
+    /// Measures of the triangles written.
     pub measures: Measures,
+    /// Vertices of the written part.
     pub vertices: u64,
+    /// Fragments found, and whether they were dropped.
     pub fragments: Fragments,
+    /// Set when the part was copied from a template.
     pub instancing: Option<Instancing>,
+    /// Set when the part was meshed in tiles.
     pub tiling: Option<Tiling>,
+    /// Time of CGAL's checks, seconds.
     pub verify_seconds: f64,
+    /// Time of writing, seconds.
     pub write_seconds: f64,
 }
 
@@ -478,6 +502,7 @@ pub struct Instancing {
     pub part_cells: [i64; 3],
     /// Cells of the template per axis.
     pub template_cells: [i64; 3],
+    /// Triangles of the template.
     pub template_triangles: u64,
     /// CGAL's checks ran on the template, which holds every kind of cell the part has; the
     /// part is written as exact copies of its cells.
@@ -487,11 +512,13 @@ pub struct Instancing {
 /// How the part was meshed when it was meshed in tiles (see [`crate::mesh::tile`]).
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Tiling {
+    /// Tiles meshed.
     pub tiles: u64,
     /// Tile edge, samples.
     pub tile_samples: i64,
     /// Samples meshed around each tile and not kept.
     pub margin_samples: i64,
+    /// What was checked, and by whom: edges per tile by latvox, self-intersections by CGAL.
     pub verified: &'static str,
 }
 

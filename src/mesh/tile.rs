@@ -58,13 +58,18 @@ pub fn tiles(region: IndexBox, edge: i64) -> Vec<IndexBox> {
 /// What the tiled meshing wrote and found.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct TiledOutcome {
+    /// Measures of the triangles written.
     pub measures: Measures,
+    /// Vertices of the part: each counted in the tile holding its voxel.
     pub vertices: u64,
+    /// Tiles meshed.
     pub tiles: u64,
     /// Kept triangles' edges that did not meet exactly one other triangle running the other way
     /// (an edge between two tiles is looked at from both).
     pub bad_edges: u64,
+    /// Whether CGAL looked for self-intersections.
     pub self_intersection_checked: bool,
+    /// Whether CGAL found a kept triangle intersecting another.
     pub self_intersecting: bool,
 }
 

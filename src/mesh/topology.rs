@@ -25,10 +25,12 @@ pub struct Topology {
 pub struct UnionFind(pub Vec<u32>);
 
 impl UnionFind {
+    /// `n` singleton sets, `0..n`.
     pub fn new(n: usize) -> Self {
         UnionFind((0..n as u32).collect())
     }
 
+    /// The root of `x`'s set.
     pub fn find(&mut self, mut x: u32) -> u32 {
         while self.0[x as usize] != x {
             let p = self.0[x as usize];
@@ -38,6 +40,7 @@ impl UnionFind {
         x
     }
 
+    /// Joins the sets of `a` and `b`.
     pub fn union(&mut self, a: u32, b: u32) {
         let (ra, rb) = (self.find(a), self.find(b));
         if ra != rb {
@@ -61,6 +64,7 @@ pub fn repeats_vertex(mesh: &Mesh, f: usize) -> bool {
 }
 
 impl Topology {
+    /// The topology of `mesh`.
     pub fn new(mesh: &Mesh) -> Self {
         let nf = mesh.triangle_count();
         let active: Vec<bool> = (0..nf)
@@ -112,6 +116,7 @@ impl Topology {
         }
     }
 
+    /// Number of undirected edges.
     pub fn edge_count(&self) -> usize {
         self.edge_start.len() - 1
     }
@@ -249,7 +254,9 @@ impl Topology {
 /// A hole's outline.
 #[derive(Debug, Clone)]
 pub struct BoundaryLoop {
+    /// The vertices in order, wound as the filling facets would be.
     pub vertices: Vec<u32>,
+    /// Whether the chain closes (false at non-manifold vertices).
     pub closed: bool,
 }
 

@@ -18,9 +18,11 @@ pub struct FileRepairReport {
     pub output: String,
     /// The input's format.
     pub format: Format,
+    /// What reading did to the input (faces skipped, polygons split, vertices merged).
     pub reading: Reading,
     /// The input's check (self-intersections are looked for on the result only).
     pub before: CheckReport,
+    /// The defect classes found in the input, with their counts.
     pub defects_before: Defects,
     /// What repair changed.
     pub repair: RepairReport,
@@ -28,6 +30,7 @@ pub struct FileRepairReport {
     pub normals_recomputed: u64,
     /// The check of the file as written and read back.
     pub after: CheckReport,
+    /// The defect classes left in the written file, with their counts.
     pub defects_after: Defects,
     /// The verdict on `after` (in JSON, the one flag `valid_solid`).
     #[serde(

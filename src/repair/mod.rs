@@ -34,6 +34,7 @@ pub use holes::PLANAR_REL;
 /// How to repair.
 #[derive(Debug, Clone, Copy)]
 pub struct RepairOptions {
+    /// Fill holes (planar ones by triangulating the loop, curved ones with CGAL).
     pub fill_holes: bool,
     /// Fair curved hole patches (CGAL); otherwise triangulate and refine only.
     pub fair: bool,
@@ -60,16 +61,22 @@ impl Default for RepairOptions {
 /// One kind of change and how many times it was made.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Change {
+    /// What was changed (e.g. `duplicate facets removed`).
     pub kind: &'static str,
+    /// How many times.
     pub count: u64,
 }
 
 /// A shell repair could not close.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct OpenShell {
+    /// Facets in the shell.
     pub facets: u64,
+    /// Edges of the shell with only one facet.
     pub boundary_edges: u64,
+    /// Closed loops of boundary edges (holes).
     pub hole_loops: u64,
+    /// Whether the shell was dropped (`drop_open_shells`).
     pub dropped: bool,
 }
 
@@ -84,7 +91,9 @@ pub struct RepairReport {
     pub non_orientable_shells: u64,
     /// Holes neither method could fill.
     pub holes_left: u64,
+    /// Voxel size of the OpenVDB remesh, mm, when it ran.
     pub remesh_voxel: Option<f64>,
+    /// Active voxels of the remesh's level set, when it ran.
     pub remesh_active_voxels: Option<u64>,
 }
 

@@ -16,6 +16,7 @@ use faer::{Mat, Side};
 pub struct Fem {
     /// Element matrix, row-major, `m × m`.
     pub ke: Vec<f64>,
+    /// DOFs per element (8 for Q4, 24 for H8).
     pub m: usize,
     /// Element DOFs, `m` per element.
     pub edofs: Vec<usize>,
@@ -32,6 +33,7 @@ pub struct Fem {
 }
 
 impl Fem {
+    /// Sets up the assembly and the symbolic factorisation for `p` with element matrix `ke`.
     pub fn new(p: &Problem, ke: Vec<f64>) -> Result<Fem> {
         let nd = p.dofs();
         let mut fixed = vec![false; nd];

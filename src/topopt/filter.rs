@@ -13,6 +13,8 @@ pub struct ConeFilter {
 }
 
 impl ConeFilter {
+    /// The cone filter of radius `rmin` (elements) on `p`'s mesh: weights
+    /// `max(0, rmin − distance)`.
     pub fn new(p: &Problem, rmin: f64) -> ConeFilter {
         let step = (rmin.ceil() as i64 - 1).max(0);
         let (nx, ny, nz) = (p.nelx as i64, p.nely as i64, p.nelz.max(1) as i64);

@@ -26,17 +26,24 @@ pub use problem::{builtin, from_toml, parse_toml, Passive, Physics, Problem};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum FilterKind {
+    /// Filter the sensitivities (the 88-line code's `ft = 1`).
     Sensitivity,
+    /// Filter the densities (`ft = 2`; top3d's filter).
     Density,
 }
 
 /// Optimiser settings (the codes' arguments).
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Settings {
+    /// Target volume fraction, in (0, 1).
     pub volfrac: f64,
+    /// SIMP penalty exponent.
     pub penal: f64,
+    /// Filter radius, in elements.
     pub rmin: f64,
+    /// What the cone filter smooths.
     pub filter: FilterKind,
+    /// Iterations at most.
     pub max_iterations: usize,
     /// Stop when the largest density change is at most this.
     pub tolerance: f64,
@@ -45,6 +52,8 @@ pub struct Settings {
 }
 
 impl Settings {
+    /// Settings with the codes' defaults: at most 1000 iterations, stop at change ≤ 0.01, move
+    /// limit 0.2.
     pub fn new(volfrac: f64, penal: f64, rmin: f64, filter: FilterKind) -> Settings {
         Settings {
             volfrac,
@@ -95,7 +104,9 @@ pub struct Optimised {
     pub volume: Vec<f64>,
     /// Largest design change of every iteration.
     pub change: Vec<f64>,
+    /// Iterations run.
     pub iterations: usize,
+    /// Whether the change fell to `tolerance` before `max_iterations`.
     pub converged: bool,
 }
 

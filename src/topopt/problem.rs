@@ -24,19 +24,26 @@ pub enum Physics {
 /// Element state fixed by the designer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Passive {
+    /// Designed by the optimiser.
     Free,
+    /// Kept void.
     Void,
+    /// Kept solid.
     Solid,
 }
 
 /// A minimum-compliance design problem on a regular grid.
 #[derive(Debug, Clone)]
 pub struct Problem {
+    /// The problem's name: a built-in's, or the problem file's path.
     pub name: String,
+    /// Elements along x.
     pub nelx: usize,
+    /// Elements along y.
     pub nely: usize,
     /// 0 for a 2D problem.
     pub nelz: usize,
+    /// What the elements carry.
     pub physics: Physics,
     /// Fixed DOFs (any order, duplicates allowed).
     pub fixed: Vec<usize>,
@@ -53,10 +60,12 @@ pub struct Problem {
 }
 
 impl Problem {
+    /// Whether the problem is 3D (`nelz > 0`).
     pub fn is_3d(&self) -> bool {
         self.nelz > 0
     }
 
+    /// Number of elements.
     pub fn elements(&self) -> usize {
         self.nelx * self.nely * self.nelz.max(1)
     }
@@ -70,10 +79,12 @@ impl Problem {
         }
     }
 
+    /// Number of nodes.
     pub fn nodes(&self) -> usize {
         (self.nelx + 1) * (self.nely + 1) * (self.nelz + 1)
     }
 
+    /// Number of DOFs.
     pub fn dofs(&self) -> usize {
         self.nodes() * self.dofs_per_node()
     }
@@ -198,7 +209,8 @@ pub fn builtin(name: &str, dims: Option<[usize; 3]>) -> Result<Problem> {
             p.fixed.push(2 * p.nodes() - 1);
             p.loads = vec![(1, -1.0)];
         }
-        // Seed 003's cantilever: left edge clamped, unit load down at the lower right corner.
+        // Liu et al. 2018's cantilever: left edge clamped, unit load down at the lower right
+        // corner.
         "cantilever" => {
             p.fixed = (0..2 * (nely + 1)).collect();
             p.loads = vec![(2 * p.node(nelx, 0, 0) + 1, -1.0)];

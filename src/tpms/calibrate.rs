@@ -10,7 +10,7 @@
 //! 2. **Mesh level.** Meshing a surface on voxels changes its volume slightly (chords across
 //!    curved surfaces, sub-voxel features). The unit cell is meshed at the part's own voxel size
 //!    and phase twice, side by side: once with a margin of neighbouring cells, measuring the
-//!    volume inside the cell only ([`Mesh::volume_in_box`]) — what every interior cell of the
+//!    volume inside the cell only ([`crate::mesh::Mesh::volume_in_box`]) — what every interior cell of the
 //!    part contributes — and once clipped by its own box, whose difference from the first is the
 //!    effect of a cut face. A part of `nx × ny × nz` cells is predicted as
 //!    `interior + (1/nx + 1/ny + 1/nz)/3 · face`. The difference between that prediction and the
@@ -332,13 +332,15 @@ fn one_percolating_component(vals: &[f64], n: usize, member: &dyn Fn(f64) -> boo
 /// The volume fractions a surface and structure can take with both phases connected.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct FeasibleRange {
+    /// Smallest feasible volume fraction.
     pub min: f64,
+    /// Largest feasible volume fraction.
     pub max: f64,
 }
 
 /// Scans and bisects the solid's connectivity for the ends of the feasible range around the
-/// middle of the fraction range. Slow (hundreds of percolation tests): [`FEASIBLE`] holds its
-/// results, and a test recomputes them.
+/// middle of the fraction range. Slow (hundreds of percolation tests): a table holds its
+/// results ([`feasible`]), and a test recomputes them.
 pub fn feasible_range(surface: Surface, structure: Structure) -> FeasibleRange {
     percolation_range(surface, structure, NC, false)
 }
@@ -408,6 +410,7 @@ pub fn percolation_range(
 /// The calibrated level and how it was found.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Calibration {
+    /// The level `t` found for the target fraction.
     pub level: f64,
     /// Level from the exact unit cell alone.
     pub analytic_level: f64,
@@ -422,6 +425,7 @@ pub struct Calibration {
     /// Whether the meshed cell's fraction came within reach of the target (on voxels too
     /// coarse for the lattice's members it jumps past it).
     pub converged: bool,
+    /// Wall time of the calibration, seconds.
     pub seconds: f64,
 }
 

@@ -25,10 +25,13 @@ pub const MIN_WALL_VOXELS: f64 = 1.25;
 /// What to build.
 #[derive(Debug, Clone)]
 pub struct TpmsJob {
+    /// Which minimal surface.
     pub surface: Surface,
+    /// Net or sheet.
     pub structure: Structure,
     /// Target volume fraction, in (0, 1).
     pub density: f64,
+    /// The box: cell size, overall size and lower corner, mm.
     pub domain: Domain,
     /// Voxels per cell along the cell's shortest axis.
     pub resolution: u32,
@@ -57,11 +60,17 @@ pub struct TpmsJob {
 pub struct Timings {
     /// The unit cell's sample table and the calibration's meshings.
     pub calibrate: f64,
+    /// Sampling the field into OpenVDB grids.
     pub sample: f64,
+    /// OpenVDB's meshing.
     pub mesh: f64,
+    /// Snapping the vertices onto the surface and box.
     pub snap: f64,
+    /// CGAL's checks.
     pub verify: f64,
+    /// Writing the part.
     pub write: f64,
+    /// The whole job.
     pub total: f64,
 }
 
@@ -81,6 +90,7 @@ pub struct LevelSearch {
 /// A resolution at which no level gave the target density.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct ResolutionMiss {
+    /// Voxels per cell.
     pub resolution: u32,
     /// The closest volume fraction found.
     pub closest: f64,
@@ -89,34 +99,54 @@ pub struct ResolutionMiss {
 /// The JSON report of a TPMS job.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct TpmsReport {
+    /// Which minimal surface.
     #[serde(rename = "type")]
     pub surface: Surface,
+    /// Net or sheet.
     pub structure: Structure,
+    /// The level `t` the part was written at.
     pub level: f64,
+    /// The volume fraction asked for.
     pub target_density: f64,
     /// Volume fraction of the written mesh: its enclosed volume (divergence theorem over the
     /// triangles exactly as written) over the box volume.
     pub achieved_density: f64,
+    /// `achieved_density − target_density`.
     pub density_error: f64,
     /// Whether the written mesh is within 0.002 of the target density.
     pub density_met: bool,
+    /// The first guess of the level, from the unit cell.
     pub calibration: Calibration,
+    /// How the part's level was found.
     pub level_search: LevelSearch,
+    /// Volume fractions at which solid and void both stay connected.
     pub feasible_range: FeasibleRange,
+    /// Whether solid and void percolate at the level written.
     pub connectivity: Connectivity,
+    /// Voxels per cell asked for.
     pub resolution_requested: u32,
+    /// Voxels per cell used (raised for thin sheet walls or an unmet density).
     pub resolution: u32,
+    /// Voxel edge, mm.
     pub voxel_size: f64,
     /// Thinnest sheet wall, voxels (sheets only).
     pub thinnest_wall_voxels: Option<f64>,
+    /// Cell size per axis, mm.
     pub cell_size: [f64; 3],
+    /// Cells per axis (fractional where the box ends inside a cell).
     pub cells: [f64; 3],
+    /// The part's box, mm.
     #[serde(rename = "box")]
     pub bounds: Aabb,
+    /// Triangles written.
     pub triangles: u64,
+    /// Vertices of the part.
     pub vertices: u64,
+    /// Surface area of the written mesh, mm².
     pub area: f64,
+    /// Volume enclosed by the written mesh, mm³.
     pub volume: Option<f64>,
+    /// Bounding box of the written mesh, mm (`null` when empty).
     pub bounding_box: Option<Aabb>,
     /// CGAL's checks: on the written mesh, or on the template when `instancing` is set.
     pub checks: Verification,
@@ -125,11 +155,17 @@ pub struct TpmsReport {
     /// Whether what was written is one piece (`null` where it was not checked: a part meshed in
     /// tiles without a template of its cells).
     pub one_piece: Option<bool>,
+    /// Set when the part was copied from a template.
     pub instancing: Option<Instancing>,
+    /// Set when the part was meshed in tiles.
     pub tiling: Option<Tiling>,
+    /// Meshing statistics over every meshing of the job.
     pub meshing: MeshingStats,
+    /// Wall time of each stage.
     pub timings: Timings,
+    /// Warnings, one sentence each (islands, raised resolution, …).
     pub warnings: Vec<String>,
+    /// The output file, when the command line wrote one.
     pub output: Option<String>,
 }
 

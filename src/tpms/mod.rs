@@ -27,8 +27,11 @@ pub use crate::mesh::pipeline::{MeshingStats, HALF_WIDTH};
 /// A TPMS lattice clipped by a box: everything needed to mesh it, at a known level.
 #[derive(Debug, Clone, Copy)]
 pub struct Lattice {
+    /// Which minimal surface.
     pub surface: Surface,
+    /// Solid on one side of the surface (net) or around it (sheet).
     pub structure: Structure,
+    /// The level `t`: net solid where F ≤ t, sheet solid where |F| ≤ t.
     pub level: f64,
     /// Cell size per axis, mm.
     pub cell: Vec3,
@@ -39,6 +42,7 @@ pub struct Lattice {
 }
 
 impl Lattice {
+    /// The lattice's field, unclipped, its values clamped to ±`clamp` mm.
     pub fn field(&self, clamp: f64) -> TpmsField {
         TpmsField::new(
             self.surface,
@@ -164,6 +168,7 @@ impl Domain {
         Ok(Domain { cell, size, origin })
     }
 
+    /// The part's box, mm.
     pub fn bounds(&self) -> Aabb {
         Aabb {
             min: self.origin,

@@ -43,6 +43,7 @@ pub enum Structure {
 }
 
 impl Structure {
+    /// The structure's name on the command line and in reports (`net`, `sheet`).
     pub fn name(self) -> &'static str {
         match self {
             Structure::Net => "net",
@@ -52,6 +53,7 @@ impl Structure {
 }
 
 impl Surface {
+    /// Every surface.
     pub const ALL: [Surface; 7] = [
         Surface::P,
         Surface::Gyroid,
@@ -62,6 +64,7 @@ impl Surface {
         Surface::Neovius,
     ];
 
+    /// The surface's name on the command line and in reports (`p`, `gyroid`, …).
     pub fn name(self) -> &'static str {
         match self {
             Surface::P => "p",
@@ -312,7 +315,9 @@ fn eval_terms(terms: &[Term], tabs: &[AxisTable; 3]) -> (f64, Vec3) {
 /// A TPMS lattice filling all space: surface, structure, level, cell size and phase origin.
 #[derive(Debug, Clone, Copy)]
 pub struct TpmsField {
+    /// Which surface.
     pub surface: Surface,
+    /// Which side of it is solid.
     pub structure: Structure,
     /// The level `t`.
     pub level: f64,
@@ -332,6 +337,8 @@ pub struct TpmsField {
 }
 
 impl TpmsField {
+    /// The lattice of `surface` and `structure` at `level`, with cells of size `cell` (mm) and
+    /// a lattice point at `origin` (mm); values clamped to ±`clamp`.
     pub fn new(
         surface: Surface,
         structure: Structure,
@@ -468,7 +475,7 @@ impl Field for TpmsField {
 mod tests {
     use super::*;
 
-    /// The seed's formulas, written out directly, as an independent reference.
+    /// The published formulas (period 1), written out directly, as an independent reference.
     fn reference(s: Surface, u: Vec3) -> f64 {
         let (x, y, z) = (TAU * u[0], TAU * u[1], TAU * u[2]);
         let (c, sn) = (f64::cos, f64::sin);
