@@ -537,7 +537,7 @@ mod tests {
     }
 
     #[test]
-    fn values_match_the_seed_formulas() {
+    fn values_match_the_published_formulas() {
         for s in Surface::ALL {
             for u in points() {
                 let (v, _) = s.eval(u);
