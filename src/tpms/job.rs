@@ -304,40 +304,15 @@ impl TpmsJob {
                 }
             })
         };
-        let found = match attempt(start_at)? {
-            Some(f) => f,
-            None => {
-                let mut lo = start_at;
-                let mut step = (start_at / 4).max(1);
-                let mut best = loop {
-                    if lo >= limit {
-                        let closest = coarser.last().map_or(f64::NAN, |m| m.closest);
-                        return Err(Error::invalid(format!(
-                            "no level gives the {} {} a density of {} within {PROMISE} at {} to {limit} voxels per cell (closest {closest:.4}); the box may cut the lattice into pieces",
-                            s.name(),
-                            st.name(),
-                            self.density,
-                            self.resolution,
-                        )));
-                    }
-                    let r = (lo + step).min(limit);
-                    match attempt(r)? {
-                        Some(f) => break f,
-                        None => {
-                            lo = r;
-                            step *= 2;
-                        }
-                    }
-                };
-                while best.resolution - lo > 1 {
-                    let mid = lo + (best.resolution - lo) / 2;
-                    match attempt(mid)? {
-                        Some(f) => best = f,
-                        None => lo = mid,
-                    }
-                }
-                best
-            }
+        let Some(found) = pipeline::smallest_resolution(start_at, limit, &mut attempt)? else {
+            let closest = coarser.last().map_or(f64::NAN, |m| m.closest);
+            return Err(Error::invalid(format!(
+                "no level gives the {} {} a density of {} within {PROMISE} at {} to {limit} voxels per cell (closest {closest:.4}); the box may cut the lattice into pieces",
+                s.name(),
+                st.name(),
+                self.density,
+                self.resolution,
+            )));
         };
         coarser.sort_by_key(|m| m.resolution);
         if let Some(miss) = coarser.first().filter(|m| m.resolution == start_at) {
@@ -346,14 +321,16 @@ impl TpmsJob {
                 miss.resolution, self.density, miss.closest
             ));
         }
-        let Found {
+        let (
             resolution,
-            voxel,
-            cal,
-            family,
-            route,
-            solved,
-        } = found;
+            Found {
+                voxel,
+                cal,
+                family,
+                route,
+                solved,
+            },
+        ) = found;
         if let Some(why) = passed_over.first() {
             if !self.auto_resolution {
                 return Err(Error::invalid(format!(
@@ -522,7 +499,6 @@ impl TpmsJob {
         Ok((
             cal.seconds,
             Ok(Found {
-                resolution,
                 voxel,
                 cal,
                 family,
@@ -535,7 +511,6 @@ impl TpmsJob {
 
 /// A resolution at which the part reaches its density, with the level found.
 struct Found {
-    resolution: u32,
     voxel: f64,
     cal: Calibration,
     family: LatticeFamily,
