@@ -21,7 +21,7 @@ pub use verdict::Verdict;
 use crate::error::Result;
 use crate::field::Vec3;
 use crate::mesh::topology::{half_edge, Topology};
-use crate::mesh::{cross, dot, norm, sub, Mesh};
+use crate::mesh::{cross, dot, norm, signed_volume, sub, Mesh};
 use rayon::prelude::*;
 
 /// A facet whose area is below this fraction of its longest edge squared is degenerate
@@ -620,7 +620,7 @@ pub fn check(
                     let (mut volume, mut area) = (0.0, 0.0);
                     for &f in fs {
                         let [a, b, c] = mesh.triangle(f as usize);
-                        volume += dot(a, cross(b, c)) / 6.0;
+                        volume += signed_volume(a, b, c);
                         area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
                     }
                     let [edges, boundary_edges, nm] = sh[s];

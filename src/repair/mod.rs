@@ -24,7 +24,7 @@ mod split;
 use crate::check::{self, zero_area};
 use crate::error::Result;
 use crate::mesh::topology::Topology;
-use crate::mesh::{cross, dot, sub, Mesh};
+use crate::mesh::{signed_volume, sub, Mesh};
 use crate::progress::Progress;
 use rayon::prelude::*;
 
@@ -447,7 +447,7 @@ fn orient_outward(w: &mut Work) -> u64 {
             .iter()
             .map(|&f| {
                 let [a, b, c] = w.mesh.triangle(f as usize);
-                dot(a, cross(b, c)) / 6.0
+                signed_volume(a, b, c)
             })
             .sum();
         if (vol > 0.0) != (d % 2 == 0) && vol != 0.0 {
