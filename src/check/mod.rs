@@ -302,57 +302,83 @@ pub fn t_junctions(mesh: &Mesh, topo: &Topology, tolerance: f64) -> Vec<TJunctio
         .fold(0.0, f64::max)
         .max(eps)
         + eps;
-    let key =
-        |p: Vec3| p.map(|x| ((x - bb.min[0].min(bb.min[1]).min(bb.min[2])) / cell).floor() as i64);
-    let mut grid: std::collections::HashMap<[i64; 3], Vec<u32>> = Default::default();
+    let mut grid = VertexGrid {
+        origin: bb.min[0].min(bb.min[1]).min(bb.min[2]),
+        cell,
+        cells: Default::default(),
+    };
     for &v in &verts {
-        grid.entry(key(mesh.vertex(v))).or_default().push(v);
+        grid.cells
+            .entry(grid.key(mesh.vertex(v)))
+            .or_default()
+            .push(v);
     }
     boundary
         .par_iter()
-        .flat_map_iter(|&h| {
-            let (a, b) = half_edge(mesh, h);
-            let (pa, pb) = (mesh.vertex(a), mesh.vertex(b));
-            let d = sub(pb, pa);
-            let len2 = dot(d, d);
-            let (ka, kb) = (key(pa), key(pb));
-            let mut found = Vec::new();
-            if len2 == 0.0 {
-                return found;
-            }
-            let lo = [0, 1, 2].map(|i| ka[i].min(kb[i]) - 1);
-            let hi = [0, 1, 2].map(|i| ka[i].max(kb[i]) + 1);
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        let Some(list) = grid.get(&[x, y, z]) else {
-                            continue;
-                        };
-                        for &v in list {
-                            if v == a || v == b {
-                                continue;
-                            }
-                            let p = mesh.vertex(v);
-                            let t = dot(sub(p, pa), d) / len2;
-                            let len = len2.sqrt();
-                            if t * len <= eps || (1.0 - t) * len <= eps {
-                                continue;
-                            }
-                            let q = [0, 1, 2].map(|i| pa[i] + t * d[i]);
-                            if norm(sub(p, q)) <= eps {
-                                found.push(TJunction {
-                                    half_edge: h,
-                                    vertex: v,
-                                    t,
-                                });
-                            }
-                        }
+        .flat_map_iter(|&h| junctions_inside(mesh, &grid, h, eps))
+        .collect()
+}
+
+/// Vertices bucketed in cubic cells.
+struct VertexGrid {
+    /// Where cell 0 starts on every axis, mm.
+    origin: f64,
+    /// Cell edge, mm.
+    cell: f64,
+    /// The vertices in each cell.
+    cells: std::collections::HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl VertexGrid {
+    /// The cell of point `p`.
+    fn key(&self, p: Vec3) -> [i64; 3] {
+        p.map(|x| ((x - self.origin) / self.cell).floor() as i64)
+    }
+}
+
+/// The vertices of `grid` lying inside half-edge `h` (farther than `eps` from its ends, within
+/// `eps` of it).
+fn junctions_inside(mesh: &Mesh, grid: &VertexGrid, h: u32, eps: f64) -> Vec<TJunction> {
+    let (a, b) = half_edge(mesh, h);
+    let (pa, pb) = (mesh.vertex(a), mesh.vertex(b));
+    let d = sub(pb, pa);
+    let len2 = dot(d, d);
+    let (ka, kb) = (grid.key(pa), grid.key(pb));
+    let mut found = Vec::new();
+    if len2 == 0.0 {
+        return found;
+    }
+    let lo = [0, 1, 2].map(|i| ka[i].min(kb[i]) - 1);
+    let hi = [0, 1, 2].map(|i| ka[i].max(kb[i]) + 1);
+    for x in lo[0]..=hi[0] {
+        for y in lo[1]..=hi[1] {
+            for z in lo[2]..=hi[2] {
+                let Some(list) = grid.cells.get(&[x, y, z]) else {
+                    continue;
+                };
+                for &v in list {
+                    if v == a || v == b {
+                        continue;
+                    }
+                    let p = mesh.vertex(v);
+                    let t = dot(sub(p, pa), d) / len2;
+                    let len = len2.sqrt();
+                    if t * len <= eps || (1.0 - t) * len <= eps {
+                        continue;
+                    }
+                    let q = [0, 1, 2].map(|i| pa[i] + t * d[i]);
+                    if norm(sub(p, q)) <= eps {
+                        found.push(TJunction {
+                            half_edge: h,
+                            vertex: v,
+                            t,
+                        });
                     }
                 }
             }
-            found
-        })
-        .collect()
+        }
+    }
+    found
 }
 
 /// Orientation of every active facet relative to its shell's first facet, by a breadth-first walk
