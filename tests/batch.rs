@@ -1,7 +1,8 @@
 //! `latvox batch`, run as a user runs it: every job's part checked with computations independent
 //! of latvox (`common`: STL reading, edge counting, divergence volume), a batch job compared
-//! vertex for vertex with the same job run by `latvox tpms`, a batch killed with SIGKILL and resumed,
-//! shards whose union is the whole batch, failures reported and retried.
+//! vertex for vertex with the same job run by `latvox tpms`, `topo` and `repair` jobs beside
+//! `tpms` ones, a batch killed with SIGKILL and resumed, shards whose union is the whole batch,
+//! failures reported and retried.
 
 mod common;
 use common::*;
@@ -191,6 +192,164 @@ fn every_job_is_made_like_the_subcommand_makes_it() {
     );
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert_same_part(&d.join("by-hand.stl"), &d.join("single/d-sheet.stl"));
+    assert!(temporaries(&d.join("out")).is_empty());
+}
+
+/// A 32 × 16 mm plate with an 8 × 4 mm hole, as a density field of 2 mm elements (rows from the
+/// top); returns the field's values.
+fn write_plate_field(path: &Path) -> Vec<f64> {
+    let (ny, nx) = (8, 16);
+    let mut field = vec![0.0; nx * ny];
+    for y in 1..7 {
+        for x in 1..15 {
+            let hole = (3..5).contains(&y) && (6..10).contains(&x);
+            field[y * nx + x] = if hole { 0.0 } else { 1.0 };
+        }
+    }
+    let mut buf = Vec::new();
+    latvox::io::npy::write(&mut buf, &[ny, nx], &field).unwrap();
+    std::fs::write(path, buf).unwrap();
+    field
+}
+
+/// A 10 mm cube, outward, with one facet left out (a hole), as ASCII STL.
+fn write_open_cube(path: &Path) {
+    let p = |i: usize| [i & 1, (i >> 1) & 1, (i >> 2) & 1].map(|b| 10.0 * b as f64);
+    let faces = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let mut text = String::from("solid open\n");
+    for (k, q) in faces.iter().enumerate() {
+        for (n, t) in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]].iter().enumerate() {
+            if k == 0 && n == 1 {
+                continue;
+            }
+            text.push_str("facet normal 0 0 0\nouter loop\n");
+            for &v in t {
+                let [x, y, z] = p(v);
+                text.push_str(&format!("vertex {x} {y} {z}\n"));
+            }
+            text.push_str("endloop\nendfacet\n");
+        }
+    }
+    text.push_str("endsolid open\n");
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn topo_and_repair_jobs_make_their_parts_and_are_recorded() {
+    let dir = tempdir();
+    let d = dir.path();
+    let field = write_plate_field(&d.join("plate.npy"));
+    write_open_cube(&d.join("open.stl"));
+    let jobs = "[[job]]\ncommand = \"topo\"\ninput = \"plate.npy\"\noutput = \"out/plate.stl\"\n\
+                element-size = 2\nmin-feature = 1\niges = \"out/plate.igs\"\n\n\
+                [[job]]\ncommand = \"topo\"\ninput = \"plate.npy\"\noutput = \"out/thin.stl\"\n\
+                element-size = 2\nmin-feature = 6\nmax-iterations = 1\n\n\
+                [[job]]\ncommand = \"repair\"\ninput = \"open.stl\"\noutput = \"out/cube.stl\"\n";
+    std::fs::write(d.join("jobs.toml"), jobs).unwrap();
+    let o = batch(d, &["jobs.toml", "-q"]);
+    // The second job's printer limit (6 mm features) is more than one pass can meet.
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+
+    let rows = summary_rows(&d.join("jobs-summary.json"));
+    let expect = [
+        (1, "topo", "out/plate.stl", "ok"),
+        (2, "topo", "out/thin.stl", "defects"),
+        (3, "repair", "out/cube.stl", "ok"),
+    ];
+    for (job, command, output, status) in expect {
+        let r = &rows[&job];
+        assert_eq!(
+            (
+                r["command"].as_str(),
+                r["output"].as_str(),
+                r["status"].as_str()
+            ),
+            (Some(command), Some(output), Some(status)),
+            "{r}"
+        );
+        let report = json(&d.join(output).with_extension("json"));
+        assert_eq!(report["batch"]["outcome"], status);
+        assert_eq!(report["batch"]["hash"], r["hash"]);
+        // The part is written either way: closed, wound consistently.
+        assert_eq!(
+            edges(&read_stl(&d.join(output))),
+            Edges::default(),
+            "{output}"
+        );
+    }
+
+    // The plate: its volume is the thresholded elements' area times the thickness (one
+    // element), counted here from the field; its CAD curves are an output of the job too.
+    let solid = field.iter().filter(|&&v| v >= 0.5).count() as f64;
+    let v = volume(&read_stl(&d.join("out/plate.stl")));
+    assert!((v / (solid * 4.0 * 2.0) - 1.0).abs() < 0.01, "volume {v}");
+    let plate = json(&d.join("out/plate.json"));
+    assert_eq!(plate["clean"], true);
+    let outputs: Vec<(String, u64)> = plate["batch"]["outputs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| {
+            (
+                o["path"].as_str().unwrap().into(),
+                o["bytes"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    let size = |p: &str| std::fs::metadata(d.join(p)).unwrap().len();
+    assert_eq!(
+        outputs,
+        [
+            ("out/plate.stl".into(), size("out/plate.stl")),
+            ("out/plate.igs".into(), size("out/plate.igs")),
+        ]
+    );
+    assert_eq!(json(&d.join("out/thin.json"))["clean"], false);
+
+    // The cube: its hole filled, the whole 1000 mm³ enclosed.
+    let cube = json(&d.join("out/cube.json"));
+    assert_eq!(cube["valid_solid"], true);
+    let v = volume(&read_stl(&d.join("out/cube.stl")));
+    assert!((v - 1000.0).abs() < 1e-6, "volume {v}");
+
+    // The same part as `latvox topo` makes.
+    let o = run(
+        &[
+            "topo",
+            "plate.npy",
+            "--element-size",
+            "2",
+            "--min-feature",
+            "1",
+            "-q",
+            "-o",
+            "by-hand.stl",
+            "--report",
+            "by-hand.json",
+        ],
+        d,
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_same_part(&d.join("by-hand.stl"), &d.join("out/plate.stl"));
+
+    // Every output counts: without its curves the plate runs again; the cube does not.
+    std::fs::remove_file(d.join("out/plate.igs")).unwrap();
+    let o = batch(d, &["jobs.toml", "-q"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let rows = summary_rows(&d.join("jobs-summary.json"));
+    let status: Vec<&str> = rows
+        .values()
+        .map(|r| r["status"].as_str().unwrap())
+        .collect();
+    assert_eq!(status, ["ok", "defects", "skipped"]);
+    assert!(d.join("out/plate.igs").is_file());
     assert!(temporaries(&d.join("out")).is_empty());
 }
 

@@ -10,6 +10,7 @@ use super::jobfile::{Job, JobFile};
 use super::resume::{self, FileRecord, Outcome, Provenance, SlurmIds};
 use super::shard::Shard;
 use super::summary::{Counts, JobName, JobResult, Status, Summary};
+use crate::check::Verdict;
 use crate::error::{Error, Result};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -32,6 +33,22 @@ pub struct TaskReport {
     pub passed: bool,
     /// Warnings the subcommand gave (the summary counts them).
     pub warnings: Vec<String>,
+}
+
+impl TaskReport {
+    /// The report of a job that made a part: `report` is the subcommand's, and the job passed
+    /// when `verdict` finds the part a valid solid.
+    pub fn new(
+        report: &impl serde::Serialize,
+        verdict: &Verdict,
+        warnings: Vec<String>,
+    ) -> Result<TaskReport> {
+        Ok(TaskReport {
+            report: serde_json::to_value(report).map_err(|e| Error::invalid(e.to_string()))?,
+            passed: verdict.is_valid_solid(),
+            warnings,
+        })
+    }
 }
 
 /// How to run.

@@ -3,7 +3,9 @@
 //! Parameter Data (columns 1–64, back-pointer to the entity's DE line in 66–72), Terminate.
 
 use super::bspline::Periodic;
+use crate::error::Result;
 use std::io::Write;
+use std::path::Path;
 
 fn hollerith(s: &str) -> String {
     format!("{}H{}", s.len(), s)
@@ -39,6 +41,42 @@ fn wrap(fields: &[String], w: usize) -> Vec<String> {
         lines.push(cur);
     }
     lines
+}
+
+/// Writes `curves` (mm) to the IGES file `path`, atomically, named after the file and stamped
+/// with the time of writing.
+pub fn write_file(path: &Path, curves: &[Periodic]) -> Result<()> {
+    let name = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let stamp = stamp(std::time::SystemTime::now());
+    crate::io::atomic::write_atomic(path, |w| write(w, curves, &name, &stamp))
+}
+
+/// The IGES time stamp of `t`: `YYYYMMDD.HHMMSS`, UTC.
+pub fn stamp(t: std::time::SystemTime) -> String {
+    let secs = t
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs())
+        .unwrap_or(0);
+    let (days, rem) = (secs / 86_400, secs % 86_400);
+    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
+    let z = days as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}{month:02}{day:02}.{:02}{:02}{:02}",
+        rem / 3600,
+        (rem / 60) % 60,
+        rem % 60
+    )
 }
 
 /// Writes `curves` (mm) as IGES. `name` goes into the header; `stamp` is the
@@ -156,4 +194,14 @@ pub fn write(
         writeln!(w, "{line}")?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn stamp_is_the_utc_date_and_time() {
+        let t = std::time::UNIX_EPOCH + std::time::Duration::from_secs(1_519_907_696);
+        assert_eq!(super::stamp(t), "20180301.123456");
+        assert_eq!(super::stamp(std::time::UNIX_EPOCH), "19700101.000000");
+    }
 }

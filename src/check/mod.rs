@@ -20,8 +20,8 @@ pub use verdict::Verdict;
 
 use crate::error::Result;
 use crate::field::Vec3;
-use crate::mesh::topology::{half_edge, Topology};
-use crate::mesh::{cross, dot, norm, sub, Mesh};
+use crate::mesh::topology::{half_edge, Shells, Topology};
+use crate::mesh::{cross, dot, norm, signed_volume, sub, Mesh};
 use rayon::prelude::*;
 
 /// A facet whose area is below this fraction of its longest edge squared is degenerate
@@ -302,57 +302,83 @@ pub fn t_junctions(mesh: &Mesh, topo: &Topology, tolerance: f64) -> Vec<TJunctio
         .fold(0.0, f64::max)
         .max(eps)
         + eps;
-    let key =
-        |p: Vec3| p.map(|x| ((x - bb.min[0].min(bb.min[1]).min(bb.min[2])) / cell).floor() as i64);
-    let mut grid: std::collections::HashMap<[i64; 3], Vec<u32>> = Default::default();
+    let mut grid = VertexGrid {
+        origin: bb.min[0].min(bb.min[1]).min(bb.min[2]),
+        cell,
+        cells: Default::default(),
+    };
     for &v in &verts {
-        grid.entry(key(mesh.vertex(v))).or_default().push(v);
+        grid.cells
+            .entry(grid.key(mesh.vertex(v)))
+            .or_default()
+            .push(v);
     }
     boundary
         .par_iter()
-        .flat_map_iter(|&h| {
-            let (a, b) = half_edge(mesh, h);
-            let (pa, pb) = (mesh.vertex(a), mesh.vertex(b));
-            let d = sub(pb, pa);
-            let len2 = dot(d, d);
-            let (ka, kb) = (key(pa), key(pb));
-            let mut found = Vec::new();
-            if len2 == 0.0 {
-                return found;
-            }
-            let lo = [0, 1, 2].map(|i| ka[i].min(kb[i]) - 1);
-            let hi = [0, 1, 2].map(|i| ka[i].max(kb[i]) + 1);
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        let Some(list) = grid.get(&[x, y, z]) else {
-                            continue;
-                        };
-                        for &v in list {
-                            if v == a || v == b {
-                                continue;
-                            }
-                            let p = mesh.vertex(v);
-                            let t = dot(sub(p, pa), d) / len2;
-                            let len = len2.sqrt();
-                            if t * len <= eps || (1.0 - t) * len <= eps {
-                                continue;
-                            }
-                            let q = [0, 1, 2].map(|i| pa[i] + t * d[i]);
-                            if norm(sub(p, q)) <= eps {
-                                found.push(TJunction {
-                                    half_edge: h,
-                                    vertex: v,
-                                    t,
-                                });
-                            }
-                        }
+        .flat_map_iter(|&h| junctions_inside(mesh, &grid, h, eps))
+        .collect()
+}
+
+/// Vertices bucketed in cubic cells.
+struct VertexGrid {
+    /// Where cell 0 starts on every axis, mm.
+    origin: f64,
+    /// Cell edge, mm.
+    cell: f64,
+    /// The vertices in each cell.
+    cells: std::collections::HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl VertexGrid {
+    /// The cell of point `p`.
+    fn key(&self, p: Vec3) -> [i64; 3] {
+        p.map(|x| ((x - self.origin) / self.cell).floor() as i64)
+    }
+}
+
+/// The vertices of `grid` lying inside half-edge `h` (farther than `eps` from its ends, within
+/// `eps` of it).
+fn junctions_inside(mesh: &Mesh, grid: &VertexGrid, h: u32, eps: f64) -> Vec<TJunction> {
+    let (a, b) = half_edge(mesh, h);
+    let (pa, pb) = (mesh.vertex(a), mesh.vertex(b));
+    let d = sub(pb, pa);
+    let len2 = dot(d, d);
+    let (ka, kb) = (grid.key(pa), grid.key(pb));
+    let mut found = Vec::new();
+    if len2 == 0.0 {
+        return found;
+    }
+    let lo = [0, 1, 2].map(|i| ka[i].min(kb[i]) - 1);
+    let hi = [0, 1, 2].map(|i| ka[i].max(kb[i]) + 1);
+    for x in lo[0]..=hi[0] {
+        for y in lo[1]..=hi[1] {
+            for z in lo[2]..=hi[2] {
+                let Some(list) = grid.cells.get(&[x, y, z]) else {
+                    continue;
+                };
+                for &v in list {
+                    if v == a || v == b {
+                        continue;
+                    }
+                    let p = mesh.vertex(v);
+                    let t = dot(sub(p, pa), d) / len2;
+                    let len = len2.sqrt();
+                    if t * len <= eps || (1.0 - t) * len <= eps {
+                        continue;
+                    }
+                    let q = [0, 1, 2].map(|i| pa[i] + t * d[i]);
+                    if norm(sub(p, q)) <= eps {
+                        found.push(TJunction {
+                            half_edge: h,
+                            vertex: v,
+                            t,
+                        });
                     }
                 }
             }
-            found
-        })
-        .collect()
+        }
+    }
+    found
 }
 
 /// Orientation of every active facet relative to its shell's first facet, by a breadth-first walk
@@ -478,26 +504,241 @@ pub fn nesting(mesh: &Mesh, members: &[Vec<u32>], closed: &[bool]) -> Vec<Option
         .collect()
 }
 
-/// Facet lists per shell.
-pub fn shell_members(shell_of: &[u32], shells: usize) -> Vec<Vec<u32>> {
-    let mut m = vec![Vec::new(); shells];
-    for (f, &s) in shell_of.iter().enumerate() {
-        if s != u32::MAX {
-            m[s as usize].push(f as u32);
-        }
-    }
-    m
+/// The facets that take no part in a solid: those with a repeated vertex, those of zero area,
+/// and the extra copies of duplicated facets. `check` counts them; `repair` removes them.
+#[derive(Debug, Clone)]
+pub struct FacetDefects {
+    /// Facets with the same vertex twice.
+    pub repeated_vertex: u64,
+    /// Per facet: three distinct vertices and (numerically) zero area ([`zero_area`]).
+    pub zero_area: Vec<bool>,
+    /// Extra copies of a facet ([`duplicate_facets`]).
+    pub duplicates: Vec<u32>,
 }
 
-/// Whole-mesh counts made alongside the self-intersection search.
-struct EdgeCounts {
-    boundary: u64,
-    non_manifold: u64,
-    inconsistent: u64,
-    hole_loops: u64,
+impl FacetDefects {
+    /// The degenerate and duplicate facets of `mesh`, whose topology is `topo`.
+    pub fn find(mesh: &Mesh, topo: &Topology) -> FacetDefects {
+        let zero_area = (0..mesh.triangle_count())
+            .into_par_iter()
+            .map(|f| topo.active[f] && zero_area(mesh, f))
+            .collect();
+        FacetDefects {
+            repeated_vertex: topo.active.iter().filter(|a| !**a).count() as u64,
+            zero_area,
+            duplicates: duplicate_facets(mesh, topo),
+        }
+    }
+
+    /// How many facets have zero area.
+    pub fn zero_area_count(&self) -> u64 {
+        self.zero_area.iter().filter(|z| **z).count() as u64
+    }
+}
+
+/// Closed loops of boundary edges (holes) and the chains that do not close.
+struct Holes {
+    /// Closed loops, per shell.
+    per_shell: Vec<u64>,
+    /// Closed loops, all shells.
+    loops: u64,
+    /// Chains that do not close (at non-manifold vertices).
     open_chains: u64,
-    non_manifold_vertices: u64,
+}
+
+/// The holes of `mesh`, each counted in the shell that owns its first edge.
+fn holes(mesh: &Mesh, topo: &Topology, shells: &Shells) -> Holes {
+    let mut h = Holes {
+        per_shell: vec![0; shells.count()],
+        loops: 0,
+        open_chains: 0,
+    };
+    for l in &topo.boundary_loops(mesh) {
+        if l.closed {
+            h.loops += 1;
+            // The loop's first edge belongs to a facet of the loop's shell.
+            let (b, a) = (l.vertices[0], l.vertices[1]);
+            if let Some(s) = boundary_shell(mesh, topo, &shells.of_facet, a, b) {
+                h.per_shell[s] += 1;
+            }
+        } else {
+            h.open_chains += 1;
+        }
+    }
+    h
+}
+
+/// Vertices some facet uses, and of those the non-manifold ones (where two or more fans meet).
+fn vertex_counts(mesh: &Mesh, topo: &Topology) -> (u64, u64) {
+    let fans = topo.fans(mesh);
+    let nv = mesh.vertex_count();
+    let mut first_fan = vec![u32::MAX; nv];
+    let mut nm_vertex = vec![false; nv];
+    let mut used = vec![false; nv];
+    for (f, active) in topo.active.iter().enumerate() {
+        for k in 0..3 {
+            let c = 3 * f + k;
+            let v = mesh.indices[c] as usize;
+            used[v] = true;
+            if !active {
+                continue;
+            }
+            if first_fan[v] == u32::MAX {
+                first_fan[v] = fans[c];
+            } else if first_fan[v] != fans[c] {
+                nm_vertex[v] = true;
+            }
+        }
+    }
+    let count = |v: &[bool]| v.iter().filter(|x| **x).count() as u64;
+    (count(&used), count(&nm_vertex))
+}
+
+/// Vertices of each shell, counted with a last-seen marker (a vertex shared by shells touching
+/// there counts in each).
+fn shell_vertex_counts(mesh: &Mesh, shells: &Shells) -> Vec<u64> {
+    let mut counts = vec![0u64; shells.count()];
+    let mut seen_in = vec![u32::MAX; mesh.vertex_count()];
+    for (s, fs) in shells.members.iter().enumerate() {
+        for &f in fs {
+            for k in 0..3 {
+                let v = mesh.indices[3 * f as usize + k] as usize;
+                if seen_in[v] != s as u32 {
+                    seen_in[v] = s as u32;
+                    counts[s] += 1;
+                }
+            }
+        }
+    }
+    counts
+}
+
+/// Each shell's counts and measures; nesting and orientation are decided by
+/// [`orient_shell_reports`].
+fn shell_reports(
+    mesh: &Mesh,
+    shells: &Shells,
+    holes: &Holes,
+    non_orientable: &[bool],
+) -> Vec<ShellReport> {
+    let vertices = shell_vertex_counts(mesh, shells);
+    shells
+        .members
+        .par_iter()
+        .enumerate()
+        .map(|(s, fs)| {
+            let (mut volume, mut area) = (0.0, 0.0);
+            for &f in fs {
+                let [a, b, c] = mesh.triangle(f as usize);
+                volume += signed_volume(a, b, c);
+                area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
+            }
+            let e = shells.edges[s];
+            let euler = vertices[s] as i64 - e.edges as i64 + fs.len() as i64;
+            let closed = e.closed();
+            let orientable = !non_orientable[s];
+            ShellReport {
+                facets: fs.len() as u64,
+                vertices: vertices[s],
+                edges: e.edges,
+                boundary_edges: e.boundary,
+                non_manifold_edges: e.non_manifold,
+                hole_loops: holes.per_shell[s],
+                closed,
+                orientation: Orientation::Inconsistent,
+                orientable,
+                volume,
+                area,
+                euler,
+                genus: (closed && orientable && euler % 2 == 0).then_some((2 - euler) / 2),
+                edge_law: 2 * e.edges == 3 * fs.len() as u64,
+                nesting: None,
+            }
+        })
+        .collect()
+}
+
+/// Sets each shell's nesting depth and orientation (outward when its volume's sign agrees with
+/// its nesting parity); returns how many closed shells face inward.
+fn orient_shell_reports(mesh: &Mesh, shells: &Shells, reports: &mut [ShellReport]) -> u64 {
+    let solid: Vec<bool> = shells.edges.iter().map(|e| e.solid()).collect();
+    let depth = nesting(mesh, &shells.members, &solid);
+    let mut inward_shells = 0;
+    for (s, r) in reports.iter_mut().enumerate() {
+        r.nesting = depth[s];
+        r.orientation = if shells.edges[s].inconsistent > 0 || !r.orientable {
+            Orientation::Inconsistent
+        } else if !r.closed {
+            Orientation::Open
+        } else if (r.volume > 0.0) == depth[s].unwrap_or(0).is_multiple_of(2) {
+            Orientation::Outward
+        } else {
+            inward_shells += 1;
+            Orientation::Inward
+        };
+    }
+    inward_shells
+}
+
+/// The stored normals `ns` compared with the winding, degenerate facets left out.
+fn normal_report(mesh: &Mesh, topo: &Topology, zero: &[bool], ns: &[[f32; 3]]) -> NormalReport {
+    let mut r = NormalReport::default();
+    for (f, n) in ns.iter().enumerate().take(mesh.triangle_count()) {
+        if !topo.active[f] || zero[f] {
+            continue;
+        }
+        r.checked += 1;
+        let n = n.map(|x| x as f64);
+        let ln = norm(n);
+        if !(ln > 0.0 && ln.is_finite()) {
+            r.unset += 1;
+            continue;
+        }
+        let (c, _) = facet_normal(mesh, f);
+        let cos = dot(n, c) / (ln * norm(c));
+        if cos < 0.0 {
+            r.reversed += 1;
+        } else if cos < NORMAL_TOLERANCE_DEG.to_radians().cos() {
+            r.inaccurate += 1;
+        }
+    }
+    r
+}
+
+/// What the check finds besides CGAL's self-intersections (it runs alongside their search).
+struct Findings {
+    shells: Vec<ShellReport>,
+    inward_shells: u64,
+    holes: Holes,
     vertices: u64,
+    non_manifold_vertices: u64,
+    normals: Option<NormalReport>,
+    t_junctions: u64,
+}
+
+/// Everything but the self-intersections: shells, holes, vertices, stored normals, T-junctions.
+fn findings(
+    mesh: &Mesh,
+    topo: &Topology,
+    shells: &Shells,
+    non_orientable: &[bool],
+    zero: &[bool],
+    normals: Option<&[[f32; 3]]>,
+    tolerance: f64,
+) -> Findings {
+    let holes = holes(mesh, topo, shells);
+    let (vertices, non_manifold_vertices) = vertex_counts(mesh, topo);
+    let mut reports = shell_reports(mesh, shells, &holes, non_orientable);
+    let inward_shells = orient_shell_reports(mesh, shells, &mut reports);
+    Findings {
+        shells: reports,
+        inward_shells,
+        holes,
+        vertices,
+        non_manifold_vertices,
+        normals: normals.map(|ns| normal_report(mesh, topo, zero, ns)),
+        t_junctions: t_junctions(mesh, topo, tolerance).len() as u64,
+    }
 }
 
 /// Checks `mesh`; `normals` are the stored facet normals if the file had them.
@@ -506,210 +747,31 @@ pub fn check(
     normals: Option<&[[f32; 3]]>,
     opts: &CheckOptions,
 ) -> Result<CheckReport> {
-    let nf = mesh.triangle_count();
     let topo = Topology::new(mesh);
-    let (shell_of, nshells) = topo.shells(nf);
-    let members = shell_members(&shell_of, nshells);
-
-    let repeated_vertex_facets = topo.active.iter().filter(|a| !**a).count() as u64;
-    let zero: Vec<bool> = (0..nf)
-        .into_par_iter()
-        .map(|f| topo.active[f] && zero_area(mesh, f))
-        .collect();
-    let zero_area_facets = zero.iter().filter(|z| **z).count() as u64;
-    let dups = duplicate_facets(mesh, &topo);
-
-    let (flip, non_orientable) = orientation(mesh, &topo, &shell_of, nshells);
+    let shells = Shells::new(mesh, &topo);
+    let bad = FacetDefects::find(mesh, &topo);
+    let (flip, non_orientable) = orientation(mesh, &topo, &shells.of_facet, shells.count());
 
     // CGAL's self-intersection search (the costliest check, building a CGAL mesh one facet at a
     // time before its parallel search) runs alongside the rest of the check: it needs only the
     // facets to leave out and the winding.
-    let (si, (mut shell_reports, inward_shells, normal_report, tj, counts)) = rayon::join(
+    let (si, found) = rayon::join(
         || {
             opts.self_intersections
-                .then(|| self_intersections(mesh, &topo, &zero, &dups, &flip))
+                .then(|| self_intersections(mesh, &topo, &bad, &flip))
                 .transpose()
         },
         || {
-            // Edges, per shell too.
-            let mut sh = vec![[0u64; 3]; nshells]; // edges, boundary, non-manifold
-            let (mut boundary, mut non_manifold, mut inconsistent) = (0u64, 0u64, 0u64);
-            for e in 0..topo.edge_count() {
-                let hs = topo.edge(e);
-                let s = shell_of[(hs[0] / 3) as usize] as usize;
-                sh[s][0] += 1;
-                match hs.len() {
-                    1 => {
-                        boundary += 1;
-                        sh[s][1] += 1;
-                    }
-                    2 => {
-                        if half_edge(mesh, hs[0]) == half_edge(mesh, hs[1]) {
-                            inconsistent += 1;
-                        }
-                    }
-                    _ => {
-                        non_manifold += 1;
-                        sh[s][2] += 1;
-                    }
-                }
-            }
-            let loops = topo.boundary_loops(mesh);
-            let mut shell_loops = vec![0u64; nshells];
-            let mut open_chains = 0;
-            for l in &loops {
-                if l.closed {
-                    // The loop's first edge belongs to a facet of the loop's shell.
-                    let (b, a) = (l.vertices[0], l.vertices[1]);
-                    if let Some(s) = boundary_shell(mesh, &topo, &shell_of, a, b) {
-                        shell_loops[s] += 1;
-                    }
-                } else {
-                    open_chains += 1;
-                }
-            }
-
-            // Non-manifold vertices: more than one fan.
-            let fans = topo.fans(mesh);
-            let nv = mesh.vertex_count();
-            let mut first_fan = vec![u32::MAX; nv];
-            let mut nm_vertex = vec![false; nv];
-            let mut used = vec![false; nv];
-            for (f, active) in topo.active.iter().enumerate() {
-                if !active {
-                    for k in 0..3 {
-                        used[mesh.indices[3 * f + k] as usize] = true;
-                    }
-                    continue;
-                }
-                for k in 0..3 {
-                    let c = 3 * f + k;
-                    let v = mesh.indices[c] as usize;
-                    used[v] = true;
-                    if first_fan[v] == u32::MAX {
-                        first_fan[v] = fans[c];
-                    } else if first_fan[v] != fans[c] {
-                        nm_vertex[v] = true;
-                    }
-                }
-            }
-            let non_manifold_vertices = nm_vertex.iter().filter(|x| **x).count() as u64;
-            let vertices = used.iter().filter(|x| **x).count() as u64;
-
-            // Per shell measures. Vertices counted with a last-seen marker (a vertex shared by shells
-            // touching there counts in each).
-            let mut shell_vertices = vec![0u64; nshells];
-            {
-                let mut seen_in = vec![u32::MAX; nv];
-                for (s, fs) in members.iter().enumerate() {
-                    for &f in fs {
-                        for k in 0..3 {
-                            let v = mesh.indices[3 * f as usize + k] as usize;
-                            if seen_in[v] != s as u32 {
-                                seen_in[v] = s as u32;
-                                shell_vertices[s] += 1;
-                            }
-                        }
-                    }
-                }
-            }
-            let mut shell_reports: Vec<ShellReport> = members
-                .par_iter()
-                .enumerate()
-                .map(|(s, fs)| {
-                    let (mut volume, mut area) = (0.0, 0.0);
-                    for &f in fs {
-                        let [a, b, c] = mesh.triangle(f as usize);
-                        volume += dot(a, cross(b, c)) / 6.0;
-                        area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
-                    }
-                    let [edges, boundary_edges, nm] = sh[s];
-                    let euler = shell_vertices[s] as i64 - edges as i64 + fs.len() as i64;
-                    let closed = boundary_edges == 0 && nm == 0;
-                    let orientable = !non_orientable[s];
-                    ShellReport {
-                        facets: fs.len() as u64,
-                        vertices: shell_vertices[s],
-                        edges,
-                        boundary_edges,
-                        non_manifold_edges: nm,
-                        hole_loops: shell_loops[s],
-                        closed,
-                        orientation: Orientation::Inconsistent,
-                        orientable,
-                        volume,
-                        area,
-                        euler,
-                        genus: (closed && orientable && euler % 2 == 0).then_some((2 - euler) / 2),
-                        edge_law: 2 * edges == 3 * fs.len() as u64,
-                        nesting: None,
-                    }
-                })
-                .collect();
-            // Consistency of winding per shell.
-            let mut shell_inconsistent = vec![false; nshells];
-            for e in 0..topo.edge_count() {
-                let hs = topo.edge(e);
-                if hs.len() == 2 && half_edge(mesh, hs[0]) == half_edge(mesh, hs[1]) {
-                    shell_inconsistent[shell_of[(hs[0] / 3) as usize] as usize] = true;
-                }
-            }
-            let solid: Vec<bool> = shell_reports
-                .iter()
-                .enumerate()
-                .map(|(s, r)| r.closed && !shell_inconsistent[s])
-                .collect();
-            let depth = nesting(mesh, &members, &solid);
-            let mut inward_shells = 0;
-            for (s, r) in shell_reports.iter_mut().enumerate() {
-                r.nesting = depth[s];
-                r.orientation = if shell_inconsistent[s] || !r.orientable {
-                    Orientation::Inconsistent
-                } else if !r.closed {
-                    Orientation::Open
-                } else if (r.volume > 0.0) == depth[s].unwrap_or(0).is_multiple_of(2) {
-                    Orientation::Outward
-                } else {
-                    inward_shells += 1;
-                    Orientation::Inward
-                };
-            }
-
-            let normal_report = normals.map(|ns| {
-                let mut r = NormalReport::default();
-                for (f, n) in ns.iter().enumerate().take(nf) {
-                    if !topo.active[f] || zero[f] {
-                        continue;
-                    }
-                    r.checked += 1;
-                    let n = n.map(|x| x as f64);
-                    let ln = norm(n);
-                    if !(ln > 0.0 && ln.is_finite()) {
-                        r.unset += 1;
-                        continue;
-                    }
-                    let (c, _) = facet_normal(mesh, f);
-                    let cos = dot(n, c) / (ln * norm(c));
-                    if cos < 0.0 {
-                        r.reversed += 1;
-                    } else if cos < NORMAL_TOLERANCE_DEG.to_radians().cos() {
-                        r.inaccurate += 1;
-                    }
-                }
-                r
-            });
-
-            let tj = t_junctions(mesh, &topo, opts.tolerance);
-            let counts = EdgeCounts {
-                boundary,
-                non_manifold,
-                inconsistent,
-                hole_loops: loops.iter().filter(|l| l.closed).count() as u64,
-                open_chains,
-                non_manifold_vertices,
-                vertices,
-            };
-            (shell_reports, inward_shells, normal_report, tj, counts)
+            let zero = &bad.zero_area;
+            findings(
+                mesh,
+                &topo,
+                &shells,
+                &non_orientable,
+                zero,
+                normals,
+                opts.tolerance,
+            )
         },
     );
     let (self_intersections, examples) = match si? {
@@ -717,51 +779,52 @@ pub fn check(
         None => (None, Vec::new()),
     };
 
+    let edges = shells.total();
     let mut report = CheckReport {
-        facets: nf as u64,
-        vertices: counts.vertices,
-        unreferenced_vertices: mesh.vertex_count() as u64 - counts.vertices,
+        facets: mesh.triangle_count() as u64,
+        vertices: found.vertices,
+        unreferenced_vertices: mesh.vertex_count() as u64 - found.vertices,
         edges: topo.edge_count() as u64,
-        shell_count: nshells as u64,
-        boundary_edges: counts.boundary,
-        hole_loops: counts.hole_loops,
-        open_boundary_chains: counts.open_chains,
-        non_manifold_edges: counts.non_manifold,
-        non_manifold_vertices: counts.non_manifold_vertices,
-        inconsistent_edges: counts.inconsistent,
-        inward_shells,
+        shell_count: shells.count() as u64,
+        boundary_edges: edges.boundary,
+        hole_loops: found.holes.loops,
+        open_boundary_chains: found.holes.open_chains,
+        non_manifold_edges: edges.non_manifold,
+        non_manifold_vertices: found.non_manifold_vertices,
+        inconsistent_edges: edges.inconsistent,
+        inward_shells: found.inward_shells,
         non_orientable_shells: non_orientable.iter().filter(|b| **b).count() as u64,
-        repeated_vertex_facets,
-        zero_area_facets,
-        duplicate_facets: dups.len() as u64,
-        t_junctions: tj.len() as u64,
-        normals: normal_report,
+        repeated_vertex_facets: bad.repeated_vertex,
+        zero_area_facets: bad.zero_area_count(),
+        duplicate_facets: bad.duplicates.len() as u64,
+        t_junctions: found.t_junctions,
+        normals: found.normals,
         self_intersections,
         self_intersection_examples: examples,
-        volume: shell_reports.iter().map(|s| s.volume).sum(),
-        area: shell_reports.iter().map(|s| s.area).sum(),
+        volume: found.shells.iter().map(|s| s.volume).sum(),
+        area: found.shells.iter().map(|s| s.area).sum(),
         valid_solid: false,
-        shells: std::mem::take(&mut shell_reports),
+        shells: found.shells,
     };
     report.valid_solid = report.verdict().is_valid_solid();
     Ok(report)
 }
 
-/// Intersecting facet pairs (CGAL) among the facets that are neither degenerate (`zero`, or a
-/// repeated vertex) nor duplicates; up to 16 of them as examples. `flip` winds the facets
-/// consistently, so CGAL can build its mesh as given.
+/// Intersecting facet pairs (CGAL) among the facets that are neither degenerate nor duplicates;
+/// up to 16 of them as examples. `flip` winds the facets consistently, so CGAL can build its
+/// mesh as given.
 fn self_intersections(
     mesh: &Mesh,
     topo: &Topology,
-    zero: &[bool],
-    dups: &[u32],
+    bad: &FacetDefects,
     flip: &[bool],
 ) -> Result<(u64, Vec<(u32, u32)>)> {
     let nf = mesh.triangle_count();
     let mut is_dup = vec![false; nf];
-    for &d in dups {
+    for &d in &bad.duplicates {
         is_dup[d as usize] = true;
     }
+    let zero = &bad.zero_area;
     let keep: Vec<u32> = (0..nf as u32)
         .filter(|&f| topo.active[f as usize] && !zero[f as usize] && !is_dup[f as usize])
         .collect();

@@ -29,6 +29,9 @@ pub struct Verdict {
     /// The volume fraction asked for, within 0.002, for parts made to a density (`None`: not
     /// asked).
     pub density_met: Option<bool>,
+    /// No feature thinner than the printer's minimum, no island and no point contact, for parts
+    /// cleaned to a printer's limits (`None`: not asked).
+    pub features_printable: Option<bool>,
 }
 
 impl Verdict {
@@ -42,6 +45,7 @@ impl Verdict {
             && self.sound_facets
             && self.one_piece != Some(false)
             && self.density_met != Some(false)
+            && self.features_printable != Some(false)
     }
 
     /// The process exit code for this verdict: 0 for a valid solid, 1 when defects were found.
@@ -65,6 +69,7 @@ impl Verdict {
             sound_facets: self.sound_facets && o.sound_facets,
             one_piece: both(self.one_piece, o.one_piece),
             density_met: both(self.density_met, o.density_met),
+            features_printable: both(self.features_printable, o.features_printable),
         }
     }
 }
@@ -90,6 +95,7 @@ impl From<&Verification> for Verdict {
             sound_facets: true,
             one_piece: None,
             density_met: None,
+            features_printable: None,
         }
     }
 }
@@ -115,6 +121,7 @@ impl From<&CheckReport> for Verdict {
                 && normals.inaccurate == 0,
             one_piece: None,
             density_met: None,
+            features_printable: None,
         }
     }
 }
@@ -138,6 +145,7 @@ mod tests {
             sound_facets: true,
             one_piece: None,
             density_met: None,
+            features_printable: None,
         }
     }
 
@@ -177,6 +185,10 @@ mod tests {
             },
             Verdict {
                 density_met: Some(false),
+                ..ok
+            },
+            Verdict {
+                features_printable: Some(false),
                 ..ok
             },
         ] {

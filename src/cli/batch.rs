@@ -1,8 +1,9 @@
 //! `latvox batch JOBS.toml`: many part-making jobs from one job file, in one process.
 //!
 //! Each job's table becomes its subcommand's long options (`cells = [4, 4, 2]` → `--cells=4,4,2`,
-//! `ascii = true` → `--ascii`) and is parsed by that subcommand's own clap `Args` — the very
-//! parser of `latvox tpms ...` — and run in-process by the same code as the subcommand. Every job
+//! `ascii = true` → `--ascii`, `input = "a.npy"` → the positional input) and is parsed by that
+//! subcommand's own clap `Args` — the very parser of `latvox tpms ...`, `latvox topo ...` or
+//! `latvox repair ...` — and run in-process by the same code as the subcommand. Every job
 //! is parsed before any runs, so a typo in the last job stops the batch at once, not hours in.
 //! The library ([`latvox::batch`]) does the rest: shards, resuming, workers, reports, summary.
 //!
@@ -10,6 +11,8 @@
 //! [`COMMANDS`].
 
 use super::out::outln;
+use super::repair::RepairArgs;
+use super::topo::TopoArgs;
 use super::tpms::TpmsArgs;
 use clap::{Args, FromArgMatches};
 use latvox::batch::{self, Event, Job, JobFile, Settings, Shard, Status, Task, TaskReport, Value};
@@ -38,6 +41,23 @@ Job file (paths relative to it; keys are the subcommand's long options):
   density = [0.2, 0.3, 0.4]
   cells = 3
 
+  [[job]]
+  command = \"topo\"               # a density field to a printable part
+  input = \"bracket.npy\"
+  output = \"out/bracket.stl\"
+  element-size = 2
+  min-feature = 3
+  iges = \"out/bracket.igs\"       # every file the job writes is an output
+
+  [[job]]
+  command = \"repair\"             # a mesh file mended
+  input = \"scan.stl\"
+  output = \"out/scan-fixed.stl\"
+  drop-open-shells = true
+
+Jobs run the subcommands that make a part: tpms, topo and repair, with the options of
+`latvox tpms`, `latvox topo` and `latvox repair` (`input` is the input file).
+
 Examples:
   latvox batch jobs.toml                       # run all jobs, 1 worker per thread
   latvox batch jobs.toml --workers 2 --threads 8
@@ -45,10 +65,13 @@ Examples:
   latvox batch jobs.toml --shard 2/4           # every 4th job, from the 2nd
   sbatch --array=0-3 --wrap 'latvox batch jobs.toml'   # shard from SLURM_ARRAY_TASK_*
 
-Each job writes its output, then its JSON report (with a `batch` record: parameter hash, run
-id, times, host), both atomically. Running again skips jobs whose report has the same
-parameter hash and whose outputs are intact, so a killed batch resumes where it stopped;
-failed jobs run again. The summary goes to JOBS-summary.csv and .json beside the job file.
+Each job writes its outputs, then its JSON report (the subcommand's report, with a `batch`
+record: parameter hash, run id, times, host), all atomically. A job passes when its subcommand
+would exit 0: the part is a valid closed, outward solid and meets what the job asked for
+(density, one piece, printable features); otherwise it is recorded as having defects. Running
+again skips jobs whose report has the same parameter hash and whose outputs are intact, so a
+killed batch resumes where it stopped; failed jobs run again. The summary goes to
+JOBS-summary.csv and .json beside the job file.
 Exit code 0 when every job is done, 1 when some failed or found defects, 2 when the job file
 or an option is wrong (nothing is run).";
 
@@ -87,8 +110,12 @@ fn parse_shard(s: &str) -> std::result::Result<Shard, String> {
 /// How a job of a given subcommand is turned into a task.
 type ParseJob = fn(&'static str, &Job) -> std::result::Result<Box<dyn Task>, String>;
 
-/// The subcommands a job file can run.
-const COMMANDS: &[(&str, ParseJob)] = &[("tpms", parse_job::<TpmsArgs>)];
+/// The subcommands a job file can run: those that make a part.
+const COMMANDS: &[(&str, ParseJob)] = &[
+    ("tpms", parse_job::<TpmsArgs>),
+    ("topo", parse_job::<TopoArgs>),
+    ("repair", parse_job::<RepairArgs>),
+];
 
 impl Task for TpmsArgs {
     fn outputs(&self) -> Vec<PathBuf> {
@@ -97,11 +124,31 @@ impl Task for TpmsArgs {
 
     fn run(&self) -> Result<TaskReport> {
         let r = super::tpms::execute(self, &Progress::hidden())?;
-        Ok(TaskReport {
-            passed: r.verdict().is_valid_solid(),
-            warnings: r.warnings.clone(),
-            report: serde_json::to_value(&r).map_err(|e| Error::invalid(e.to_string()))?,
-        })
+        TaskReport::new(&r, &r.verdict(), r.warnings.clone())
+    }
+}
+
+impl Task for TopoArgs {
+    fn outputs(&self) -> Vec<PathBuf> {
+        self.files().paths()
+    }
+
+    fn run(&self) -> Result<TaskReport> {
+        let r = super::topo::execute(self, &Progress::hidden())?
+            .result
+            .report;
+        TaskReport::new(&r, &r.verdict(), r.warnings())
+    }
+}
+
+impl Task for RepairArgs {
+    fn outputs(&self) -> Vec<PathBuf> {
+        vec![self.output.clone()]
+    }
+
+    fn run(&self) -> Result<TaskReport> {
+        let r = super::repair::execute(self, &Progress::hidden())?;
+        TaskReport::new(&r, &r.verdict, Vec::new())
     }
 }
 

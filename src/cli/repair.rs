@@ -5,7 +5,8 @@ use super::check::{print_header, print_summary};
 use super::out::outln;
 use clap::Args;
 use latvox::io::sink::MeshFile;
-use latvox::repair::{repair_file, RepairOptions};
+use latvox::progress::Progress;
+use latvox::repair::{repair_file, FileRepairReport, RepairOptions};
 use latvox::Result;
 use std::path::PathBuf;
 
@@ -58,21 +59,38 @@ pub struct RepairArgs {
     pub remesh: Option<f64>,
 }
 
-pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
+impl RepairArgs {
+    /// The repair these arguments ask for.
+    fn options(&self) -> RepairOptions {
+        RepairOptions {
+            fill_holes: !self.no_fill,
+            fair: !self.no_fair,
+            stitch_tolerance: self.stitch_tolerance,
+            drop_open_shells: self.drop_open_shells,
+            remesh: self.remesh,
+        }
+    }
+}
+
+/// Repairs the input and writes the result (not the report), for `run` to print and `latvox
+/// batch` to record.
+pub fn execute(a: &RepairArgs, progress: &Progress) -> Result<FileRepairReport> {
     latvox::io::atomic::check_writable(&a.output)?;
     let output = MeshFile::new(&a.output, a.ascii)?;
     if let Some(r) = &a.common.report {
         latvox::io::atomic::check_writable(r)?;
     }
-    let opts = RepairOptions {
-        fill_holes: !a.no_fill,
-        fair: !a.no_fair,
-        stitch_tolerance: a.stitch_tolerance,
-        drop_open_shells: a.drop_open_shells,
-        remesh: a.remesh,
-    };
-    let progress = latvox::progress::Progress::new(quiet);
-    let r = repair_file(&a.input, &output, &a.common.options(), &opts, &progress)?;
+    repair_file(
+        &a.input,
+        &output,
+        &a.common.options(),
+        &a.options(),
+        progress,
+    )
+}
+
+pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
+    let r = execute(a, &Progress::new(quiet))?;
     if !super::emit_json(a.common.report.as_deref(), a.common.json, &r)? {
         print_header(&r.input, r.format, r.before.facets, &r.reading);
         let d = &r.defects_before.0;

@@ -4,11 +4,11 @@
 use super::out::outln;
 use super::{cgal_findings, write_json};
 use clap::Args;
-use latvox::interpret::job::{self, TopoJob};
+use latvox::interpret::job;
 use latvox::interpret::volume::Smoothing;
-use latvox::interpret::{CleanOptions, Density};
-use latvox::io::sink::MeshFile;
-use latvox::{Error, Result};
+use latvox::interpret::{interpret_file, TopoFiles, TopoOptions, TopoPart};
+use latvox::progress::Progress;
+use latvox::Result;
 use std::path::PathBuf;
 
 pub(crate) const EXAMPLES: &str = "\
@@ -117,175 +117,66 @@ pub struct TopoArgs {
     pub no_self_intersection_check: bool,
 }
 
-pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
-    let d = Density::read(&a.input, a.element_size)?;
-    let is_3d = d.is_3d;
-    if !is_3d && a.refine.is_none() && (d.nx * 8) * (d.ny * 8) > 200_000_000 {
-        return Err(Error::invalid(
-            "field too large for --refine 8; give a smaller --refine",
-        ));
-    }
-    if is_3d && (a.iges.is_some() || a.dxf.is_some()) {
-        return Err(Error::invalid(
-            "--iges/--dxf take 2D fields (boundary curves); a 3D field gives the STL only",
-        ));
-    }
-    let refine = a.refine.unwrap_or(if is_3d { 2 } else { 8 });
-    let thickness = a.thickness.unwrap_or(a.element_size);
-    let tolerance = a.tolerance.unwrap_or(0.5 * a.element_size / refine as f64);
-    if !(tolerance > 0.0 && tolerance.is_finite()) {
-        return Err(Error::invalid(
-            "--tolerance must be a positive length in mm",
-        ));
-    }
-    if a.max_iterations == 0 {
-        return Err(Error::invalid("--max-iterations must be at least 1"));
-    }
-    let job = TopoJob {
-        clean: CleanOptions {
-            cutoff: a.cutoff,
-            refine,
-            min_feature: a.min_feature,
-            filter_radius: a.filter_radius,
-            raise: 0.1,
-            max_iterations: a.max_iterations,
-        },
-        thickness,
-        tolerance,
-        fit_curves: !is_3d,
-        self_intersection: !a.no_self_intersection_check,
-        smooth_iterations: a.smooth,
-        smoothing: match a.smooth_filter {
-            SmoothArg::Gaussian => Smoothing::Gaussian,
-            SmoothArg::MeanCurvature => Smoothing::MeanCurvature,
-            SmoothArg::Laplacian => Smoothing::Laplacian,
-            SmoothArg::Mean => Smoothing::Mean,
-        },
-    };
-    if a.smooth > 0 && !is_3d {
-        return Err(Error::invalid(
-            "--smooth applies to 3D fields (2D outlines are smooth B-splines)",
-        ));
-    }
-    if a.smooth > 100 {
-        return Err(Error::invalid("--smooth takes at most 100 passes"));
-    }
-    let outputs = [
-        &Some(a.output.clone()),
-        &a.iges,
-        &a.dxf,
-        &a.report,
-        &a.cleaned,
-    ];
-    for f in outputs.into_iter().flatten() {
-        latvox::io::atomic::check_writable(f)?;
-    }
-    let output = MeshFile::new(&a.output, a.ascii)?;
-    let progress = latvox::progress::Progress::new(quiet);
-    let r = job::run(&d, &job, &progress)?;
-    output.save(&r.mesh)?;
-    let stamp = timestamp();
-    let name = |p: &PathBuf| {
-        p.file_name()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default()
-    };
-    if let Some(p) = &a.iges {
-        latvox::io::atomic::write_atomic(p, |w| {
-            latvox::cad::iges::write(w, &r.adaptive, &name(p), &stamp)
-        })?;
-        if a.uniform_too {
-            let stem = p
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            let u = p.with_file_name(format!("{stem}-uniform.igs"));
-            latvox::io::atomic::write_atomic(&u, |w| {
-                latvox::cad::iges::write(w, &r.uniform, &name(&u), &stamp)
-            })?;
+impl TopoArgs {
+    /// The job's options.
+    pub(crate) fn options(&self) -> TopoOptions {
+        TopoOptions {
+            element_size: self.element_size,
+            cutoff: self.cutoff,
+            refine: self.refine,
+            min_feature: self.min_feature,
+            filter_radius: self.filter_radius,
+            max_iterations: self.max_iterations,
+            thickness: self.thickness,
+            tolerance: self.tolerance,
+            smooth_iterations: self.smooth,
+            smoothing: match self.smooth_filter {
+                SmoothArg::Gaussian => Smoothing::Gaussian,
+                SmoothArg::MeanCurvature => Smoothing::MeanCurvature,
+                SmoothArg::Laplacian => Smoothing::Laplacian,
+                SmoothArg::Mean => Smoothing::Mean,
+            },
+            self_intersection: !self.no_self_intersection_check,
         }
     }
-    if let Some(p) = &a.dxf {
-        latvox::io::atomic::write_atomic(p, |w| latvox::cad::dxf::write(w, &r.adaptive))?;
-    }
-    if let Some(p) = &a.boundary {
-        latvox::io::atomic::write_atomic(p, |w| {
-            writeln!(w, "loop,x,y")?;
-            for (k, l) in r.loops.iter().enumerate() {
-                for q in l {
-                    writeln!(w, "{k},{:.9},{:.9}", q[0], q[1])?;
-                }
-            }
-            Ok(())
-        })?;
-    }
-    if let Some(p) = &a.cleaned {
-        let f = &r.cleaned.field;
-        let (nx, ny, nz) = (f.n[0], f.n[1], f.n[2]);
-        let mut v = Vec::with_capacity(f.len());
-        for row in 0..ny {
-            for x in 0..nx {
-                for z in 0..nz {
-                    v.push(if r.cleaned.mask[f.index(x, ny - 1 - row, z)] {
-                        1.0
-                    } else {
-                        0.0
-                    });
-                }
-            }
+
+    /// The files the job writes besides its report.
+    pub(crate) fn files(&self) -> TopoFiles {
+        TopoFiles {
+            mesh: self.output.clone(),
+            ascii: self.ascii,
+            iges: self.iges.clone(),
+            uniform_too: self.uniform_too,
+            dxf: self.dxf.clone(),
+            boundary: self.boundary.clone(),
+            cleaned: self.cleaned.clone(),
+            images: self.images.clone(),
         }
-        let shape = if is_3d {
-            vec![ny, nx, nz]
-        } else {
-            vec![ny, nx]
-        };
-        latvox::io::atomic::write_atomic(p, |w| latvox::io::npy::write(w, &shape, &v))?;
     }
-    let images = match &a.images {
-        Some(prefix) => latvox::interpret::images::write_stages(&r.cleaned, prefix)?,
-        None => Vec::new(),
-    };
-    if let Some(p) = &a.report {
-        write_json(p, &r.report)?;
-    }
-    summary(&r.report, a, &images);
-    if r.report.measure_change.abs() > 0.01 {
-        eprintln!(
-            "latvox: warning: the part's volume differs from the thresholded volume by {:+.1} % \
-             (heavy smoothing erases thin members; try fewer --smooth passes)",
-            100.0 * r.report.measure_change
-        );
-    }
-    // Features the printer cannot make that remain after the last pass are defects too.
-    Ok(if r.report.clean {
-        r.report.checks.verdict().exit_code()
-    } else {
-        1
-    })
 }
 
-fn timestamp() -> String {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_secs())
-        .unwrap_or(0);
-    let (days, rem) = (secs / 86_400, secs % 86_400);
-    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
-    let z = days as i64 + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let day = doy - (153 * mp + 2) / 5 + 1;
-    let month = if mp < 10 { mp + 3 } else { mp - 9 };
-    let year = yoe + era * 400 + i64::from(month <= 2);
-    format!(
-        "{year:04}{month:02}{day:02}.{:02}{:02}{:02}",
-        rem / 3600,
-        (rem / 60) % 60,
-        rem % 60
-    )
+/// Runs the job and writes its files (not the report), for `run` to print and `latvox batch` to
+/// record.
+pub fn execute(a: &TopoArgs, progress: &Progress) -> Result<TopoPart> {
+    interpret_file(&a.input, &a.options(), &a.files(), progress)
+}
+
+pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
+    // Fail on an unwritable destination before the work, not after.
+    if let Some(p) = &a.report {
+        latvox::io::atomic::check_writable(p)?;
+    }
+    let part = execute(a, &Progress::new(quiet))?;
+    let r = &part.result.report;
+    if let Some(p) = &a.report {
+        write_json(p, r)?;
+    }
+    summary(r, a, &part.images);
+    for w in r.warnings() {
+        eprintln!("latvox: warning: {w}");
+    }
+    // Features the printer cannot make that remain after the last pass are defects too.
+    Ok(r.verdict().exit_code())
 }
 
 fn summary(r: &job::TopoReport, a: &TopoArgs, images: &[PathBuf]) {

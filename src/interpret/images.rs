@@ -72,15 +72,22 @@ fn binary(r: &Raster, m: &Mask, solid: [u8; 3]) -> Canvas {
     c
 }
 
-/// Writes `PREFIX-raw.png`, `-thresholded`, `-skeleton`, `-final`; returns the paths.
+/// The stages drawn, in the order of their images.
+pub const STAGES: [&str; 4] = ["raw", "thresholded", "skeleton", "final"];
+
+/// The image of `stage` for `prefix`: `PREFIX-stage.png`.
+pub fn stage_path(prefix: &Path, stage: &str) -> Result<PathBuf> {
+    let stem = prefix
+        .file_name()
+        .and_then(|f| f.to_str())
+        .ok_or_else(|| Error::invalid("--images needs a file name prefix"))?;
+    Ok(prefix.with_file_name(format!("{stem}-{stage}.png")))
+}
+
+/// Writes `PREFIX-raw.png`, `-thresholded`, `-skeleton`, `-final` ([`STAGES`]); returns the
+/// paths.
 pub fn write_stages(c: &Cleaned, prefix: &Path) -> Result<Vec<PathBuf>> {
-    let name = |s: &str| -> Result<PathBuf> {
-        let stem = prefix
-            .file_name()
-            .and_then(|f| f.to_str())
-            .ok_or_else(|| Error::invalid("--images needs a file name prefix"))?;
-        Ok(prefix.with_file_name(format!("{stem}-{s}.png")))
-    };
+    let name = |s: &str| stage_path(prefix, s);
     let r = &c.raw;
     let o = slice_offset(r);
     let in_slice = |i: usize| i >= o && i < o + r.n[0] * r.n[1];

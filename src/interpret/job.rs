@@ -8,6 +8,7 @@ use super::{extrude, volume, Density};
 use crate::cad::bspline::Periodic;
 use crate::cad::fit;
 use crate::check::cgal::{verify, Verification};
+use crate::check::Verdict;
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::progress::Progress;
@@ -159,6 +160,30 @@ fn defects(a: &super::features::Analysis, is_3d: bool) -> Defects {
     }
 }
 
+impl TopoReport {
+    /// The part's verdict: CGAL's checks of the mesh, and whether every feature is one the
+    /// printer can make (no thin feature, island or point contact left after the last pass).
+    pub fn verdict(&self) -> Verdict {
+        Verdict {
+            features_printable: Some(self.clean),
+            ..self.checks.verdict()
+        }
+    }
+
+    /// Warnings, one sentence each: a part whose volume strays from the thresholded volume.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        if self.measure_change.abs() > 0.01 {
+            w.push(format!(
+                "the part's volume differs from the thresholded volume by {:+.1} % \
+                 (heavy smoothing erases thin members; try fewer --smooth passes)",
+                100.0 * self.measure_change
+            ));
+        }
+        w
+    }
+}
+
 /// Runs the job on `d`.
 pub fn run(d: &Density, job: &TopoJob, progress: &Progress) -> Result<TopoResult> {
     let t0 = Instant::now();
@@ -168,68 +193,11 @@ pub fn run(d: &Density, job: &TopoJob, progress: &Progress) -> Result<TopoResult
         clean(d, &job.clean)?
     };
     timings.clean = t0.elapsed().as_secs_f64();
-    let h = cleaned.field.h;
-    let cell = if d.is_3d { h * h * h } else { h * h };
-    let thresholded_measure = cleaned.target_pixels as f64 * cell;
-    let final_pixel_measure = cleaned.last.solid as f64 * cell;
 
     let t = Instant::now();
     let (mesh, loops) = {
         let _s = progress.stage("meshing");
-        if d.is_3d && job.smooth_iterations > 0 {
-            // Smooth once, then offset the smoothed surface until it keeps the volume.
-            let s = volume::Smoothed::new(
-                &cleaned.field,
-                cleaned.level,
-                job.smoothing,
-                job.smooth_iterations,
-            )?;
-            let mut meshed = Vec::new();
-            let offset = super::clean::secant_in(
-                |t| match s.mesh(t) {
-                    Ok(m) => {
-                        let v = m.volume();
-                        meshed.push((t, m));
-                        v
-                    }
-                    Err(_) => f64::NAN,
-                },
-                0.0,
-                thresholded_measure,
-                [-3.0 * h, 3.0 * h],
-                0.1 * h,
-            );
-            let mesh = match meshed.into_iter().find(|(t, _)| *t == offset) {
-                Some((_, m)) => m,
-                None => s.mesh(offset)?,
-            };
-            (mesh, Vec::new())
-        } else if d.is_3d {
-            // The iso-surface encloses less than the voxels it was thresholded from (thin
-            // members most): move the level until the mesh keeps the thresholded volume.
-            let mut meshed = Vec::new();
-            let level = super::clean::secant(
-                |t| match volume::mesh(&cleaned.field, t) {
-                    Ok(m) => {
-                        let v = m.volume();
-                        meshed.push((t, m));
-                        v
-                    }
-                    Err(_) => f64::NAN,
-                },
-                cleaned.level,
-                thresholded_measure,
-            );
-            let mesh = match meshed.into_iter().find(|(t, _)| *t == level) {
-                Some((_, m)) => m,
-                None => volume::mesh(&cleaned.field, level)?,
-            };
-            cleaned.level = level;
-            (mesh, Vec::new())
-        } else {
-            let loops = contour::loops(&cleaned.field, cleaned.level);
-            (extrude::extrude(&loops, job.thickness)?, loops)
-        }
+        mesh_solid(d, job, &mut cleaned)?
     };
     timings.mesh = t.elapsed().as_secs_f64();
     let t = Instant::now();
@@ -238,49 +206,152 @@ pub fn run(d: &Density, job: &TopoJob, progress: &Progress) -> Result<TopoResult
         verify(&mesh, job.self_intersection)?
     };
     timings.verify = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let fits = if job.fit_curves && !d.is_3d {
+        let _s = progress.stage("fitting B-spline curves");
+        fit_loops(&loops, job.tolerance)
+    } else {
+        Fits::default()
+    };
+    timings.fit = t.elapsed().as_secs_f64();
+    timings.total = t0.elapsed().as_secs_f64();
+    let report = TopoReport {
+        timings,
+        ..report(d, job, &cleaned, &mesh, &loops, checks, fits.loops)
+    };
+    Ok(TopoResult {
+        cleaned,
+        mesh,
+        loops,
+        uniform: fits.uniform,
+        adaptive: fits.adaptive,
+        report,
+    })
+}
+
+/// Solid volume (3D, mm³) or area (2D, mm²) of `pixels` pixels of the cleaned grid.
+fn pixel_measure(d: &Density, cleaned: &Cleaned, pixels: usize) -> f64 {
+    let h = cleaned.field.h;
+    pixels as f64 * if d.is_3d { h * h * h } else { h * h }
+}
+
+/// The cleaned solid as a closed mesh, with its boundary loops in 2D: in 2D the outline
+/// extruded; in 3D OpenVDB's surface, moved to keep the thresholded volume (by its level, or
+/// after smoothing by an offset).
+fn mesh_solid(d: &Density, job: &TopoJob, cleaned: &mut Cleaned) -> Result<(Mesh, Vec<Loop>)> {
+    let goal = pixel_measure(d, cleaned, cleaned.target_pixels);
+    let h = cleaned.field.h;
+    if d.is_3d && job.smooth_iterations > 0 {
+        // Smooth once, then offset the smoothed surface until it keeps the volume.
+        let s = volume::Smoothed::new(
+            &cleaned.field,
+            cleaned.level,
+            job.smoothing,
+            job.smooth_iterations,
+        )?;
+        let (_, mesh) = mesh_at_volume(
+            |t| s.mesh(t),
+            |volume| super::clean::secant_in(volume, 0.0, goal, [-3.0 * h, 3.0 * h], 0.1 * h),
+        )?;
+        Ok((mesh, Vec::new()))
+    } else if d.is_3d {
+        // The iso-surface encloses less than the voxels it was thresholded from (thin
+        // members most): move the level until the mesh keeps the thresholded volume.
+        let (level, mesh) = mesh_at_volume(
+            |t| volume::mesh(&cleaned.field, t),
+            |volume| super::clean::secant(volume, cleaned.level, goal),
+        )?;
+        cleaned.level = level;
+        Ok((mesh, Vec::new()))
+    } else {
+        let loops = contour::loops(&cleaned.field, cleaned.level);
+        Ok((extrude::extrude(&loops, job.thickness)?, loops))
+    }
+}
+
+/// The mesh at the parameter `search` settles on, given the volume of the mesh at a parameter
+/// (NaN where meshing fails); the meshes tried are kept, so the one found is not made twice.
+fn mesh_at_volume(
+    mesh_at: impl Fn(f64) -> Result<Mesh>,
+    search: impl FnOnce(&mut dyn FnMut(f64) -> f64) -> f64,
+) -> Result<(f64, Mesh)> {
+    let mut meshed = Vec::new();
+    let found = search(&mut |t| match mesh_at(t) {
+        Ok(m) => {
+            let v = m.volume();
+            meshed.push((t, m));
+            v
+        }
+        Err(_) => f64::NAN,
+    });
+    let mesh = match meshed.into_iter().find(|(t, _)| *t == found) {
+        Some((_, m)) => m,
+        None => mesh_at(found)?,
+    };
+    Ok((found, mesh))
+}
+
+/// The B-spline fits of the boundary loops.
+#[derive(Default)]
+struct Fits {
+    uniform: Vec<Periodic>,
+    adaptive: Vec<Periodic>,
+    loops: Vec<LoopFit>,
+}
+
+/// Uniform and adaptive closed B-spline fits of every loop within `tolerance` mm (step 3).
+fn fit_loops(loops: &[Loop], tolerance: f64) -> Fits {
+    let results: Vec<(fit::Fitted, fit::Fitted)> = loops
+        .par_iter()
+        .map(|l| {
+            let u = fit::uniform(l, tolerance);
+            let a = fit::adaptive(l, tolerance, &u);
+            (u, a)
+        })
+        .collect();
+    let mut fits = Fits::default();
+    for (l, (u, a)) in loops.iter().zip(results) {
+        fits.loops.push(LoopFit {
+            points: l.len(),
+            outer: contour::signed_area(l) > 0.0,
+            uniform_control_points: u.curve.len(),
+            uniform_max_deviation: u.max_deviation,
+            adaptive_control_points: a.curve.len(),
+            adaptive_max_deviation: a.max_deviation,
+        });
+        fits.uniform.push(u.curve);
+        fits.adaptive.push(a.curve);
+    }
+    fits
+}
+
+/// The job's report (timings left at zero, for the caller to fill in).
+fn report(
+    d: &Density,
+    job: &TopoJob,
+    cleaned: &Cleaned,
+    mesh: &Mesh,
+    loops: &[Loop],
+    checks: Verification,
+    fits: Vec<LoopFit>,
+) -> TopoReport {
+    let thresholded_measure = pixel_measure(d, cleaned, cleaned.target_pixels);
     let final_measure = if d.is_3d {
         checks.volume.unwrap_or(f64::NAN)
     } else {
         loops.iter().map(contour::signed_area).sum()
     };
-
-    let t = Instant::now();
-    let (mut uniform, mut adaptive, mut fits) = (Vec::new(), Vec::new(), Vec::new());
-    if job.fit_curves && !d.is_3d {
-        let _s = progress.stage("fitting B-spline curves");
-        let results: Vec<(fit::Fitted, fit::Fitted)> = loops
-            .par_iter()
-            .map(|l| {
-                let u = fit::uniform(l, job.tolerance);
-                let a = fit::adaptive(l, job.tolerance, &u);
-                (u, a)
-            })
-            .collect();
-        for (l, (u, a)) in loops.iter().zip(results) {
-            fits.push(LoopFit {
-                points: l.len(),
-                outer: contour::signed_area(l) > 0.0,
-                uniform_control_points: u.curve.len(),
-                uniform_max_deviation: u.max_deviation,
-                adaptive_control_points: a.curve.len(),
-                adaptive_max_deviation: a.max_deviation,
-            });
-            uniform.push(u.curve);
-            adaptive.push(a.curve);
-        }
-    }
-    timings.fit = t.elapsed().as_secs_f64();
-    timings.total = t0.elapsed().as_secs_f64();
     let (uc, ac): (usize, usize) = (
         fits.iter().map(|f| f.uniform_control_points).sum(),
         fits.iter().map(|f| f.adaptive_control_points).sum(),
     );
-    let report = TopoReport {
+    TopoReport {
         dims: [d.nx, d.ny, if d.is_3d { d.nz } else { 0 }],
         is_3d: d.is_3d,
         element_size: d.element_size,
         job: *job,
-        pixel_size: h,
+        pixel_size: cleaned.field.h,
         refined_dims: cleaned.field.n,
         initial: defects(&cleaned.initial, d.is_3d),
         remaining: defects(&cleaned.last, d.is_3d),
@@ -289,7 +360,7 @@ pub fn run(d: &Density, job: &TopoJob, progress: &Progress) -> Result<TopoResult
         passes: cleaned.passes.clone(),
         level: cleaned.level,
         thresholded_measure,
-        final_pixel_measure,
+        final_pixel_measure: pixel_measure(d, cleaned, cleaned.last.solid),
         final_measure,
         measure_change: final_measure / thresholded_measure - 1.0,
         triangles: mesh.triangle_count(),
@@ -300,14 +371,6 @@ pub fn run(d: &Density, job: &TopoJob, progress: &Progress) -> Result<TopoResult
         uniform_control_points: uc,
         adaptive_control_points: ac,
         control_point_ratio: (uc > 0).then(|| ac as f64 / uc as f64),
-        timings,
-    };
-    Ok(TopoResult {
-        cleaned,
-        mesh,
-        loops,
-        uniform,
-        adaptive,
-        report,
-    })
+        timings: Timings::default(),
+    }
 }

@@ -9,7 +9,9 @@
 //! filter, volume-keeping level) → [`skeleton`] and [`distance`] (feature size) →
 //! [`features`] (thin features, islands, point contacts) → [`mod@clean`] (the repair loop) →
 //! [`contour`] (boundary loops) → [`extrude`] (2D) or [`volume`] (3D, OpenVDB) → STL;
-//! [`images`] draws every stage; `crate::cad` fits and writes the curves.
+//! [`images`] draws every stage; `crate::cad` fits and writes the curves. [`job`] runs the
+//! stages on a field; [`mod@file`] runs them from a field file to the part and the files asked
+//! for, as `latvox topo` and `latvox batch` do.
 
 pub mod clean;
 pub mod contour;
@@ -17,6 +19,7 @@ pub mod density;
 pub mod distance;
 pub mod extrude;
 pub mod features;
+pub mod file;
 pub mod images;
 pub mod job;
 pub mod raster;
@@ -25,3 +28,4 @@ pub mod volume;
 
 pub use clean::{clean, CleanOptions, Cleaned};
 pub use density::Density;
+pub use file::{interpret_file, TopoFiles, TopoOptions, TopoPart};

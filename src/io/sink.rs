@@ -77,10 +77,10 @@ impl Measures {
     }
 
     fn add(&mut self, t: &Triangle) {
-        use crate::mesh::{cross, dot, norm, sub};
+        use crate::mesh::{cross, norm, signed_volume, sub};
         let p = t.map(|v| v.map(|x| x as f64));
         self.triangles += 1;
-        self.volume += dot(p[0], cross(p[1], p[2])) / 6.0;
+        self.volume += signed_volume(p[0], p[1], p[2]);
         self.area += 0.5 * norm(cross(sub(p[1], p[0]), sub(p[2], p[0])));
         for v in p {
             for (a, x) in v.into_iter().enumerate() {

@@ -58,7 +58,7 @@ impl Mesh {
     pub fn volume(&self) -> f64 {
         ordered_sum(self.triangle_count(), |t| {
             let [a, b, c] = self.triangle(t);
-            dot(a, cross(b, c)) / 6.0
+            signed_volume(a, b, c)
         })
     }
 
@@ -226,6 +226,12 @@ fn clipped_column_integral(tri: [Vec3; 3], b: &Aabb) -> f64 {
     clip_polygon(&poly, 2, z1, -1.0, &mut above);
     let (aa, _) = xy_moments(&above);
     (zm - z0 * am) + (z1 - z0) * aa
+}
+
+/// Triangle `abc`'s term of the divergence-theorem volume: the signed volume of the tetrahedron
+/// it spans with the origin, mm³ (summed over a closed, outward mesh: the enclosed volume).
+pub fn signed_volume(a: Vec3, b: Vec3, c: Vec3) -> f64 {
+    dot(a, cross(b, c)) / 6.0
 }
 
 pub(crate) fn sub(a: Vec3, b: Vec3) -> Vec3 {

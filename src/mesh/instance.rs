@@ -341,7 +341,7 @@ impl Template {
     /// `d · n / 3` to the divergence-theorem volume (`n` its area vector), so per kind the sum of
     /// the triangles' volumes and of their area vectors is enough.
     pub fn part_volume(&self) -> f64 {
-        use crate::mesh::{cross, dot, sub};
+        use crate::mesh::{cross, dot, signed_volume, sub};
         let pos = |v: u32| self.mesh.positions[v as usize].map(|x| x as f32 as f64);
         let per_kind: Vec<(f64, Vec3)> = self
             .quads_by_cell
@@ -352,7 +352,7 @@ impl Template {
                     let (t, u) = self.mesh.quad_triangles(q as usize);
                     for tri in std::iter::once(t).chain(u) {
                         let [a, b, c] = tri.map(pos);
-                        vol += dot(a, cross(b, c)) / 6.0;
+                        vol += signed_volume(a, b, c);
                         let n = cross(sub(b, a), sub(c, a));
                         for x in 0..3 {
                             area[x] += 0.5 * n[x];

@@ -10,8 +10,8 @@
 
 use crate::field::Aabb;
 use crate::mesh::extract::KeyedMesh;
+use crate::mesh::signed_volume;
 use crate::mesh::topology::UnionFind;
-use crate::mesh::{cross, dot};
 
 /// Fragments found (and removed, unless kept) in a mesh.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
@@ -75,7 +75,7 @@ impl Shells {
         let mut bounds = vec![empty; count as usize];
         for t in mesh.triangles() {
             let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
-            volume[of_vertex[t[0] as usize] as usize] += dot(a, cross(b, c)) / 6.0;
+            volume[of_vertex[t[0] as usize] as usize] += signed_volume(a, b, c);
         }
         for (v, p) in mesh.positions.iter().enumerate() {
             let b = &mut bounds[of_vertex[v] as usize];

@@ -322,11 +322,11 @@ pub fn measure<F: Family>(
 
 /// Enclosed volume of a keyed mesh as it is written (single-precision corners), mm³.
 pub fn keyed_volume(mesh: &KeyedMesh) -> f64 {
-    use crate::mesh::{cross, dot};
+    use crate::mesh::signed_volume;
     let tris: Vec<[u32; 3]> = mesh.triangles().collect();
     crate::mesh::ordered_sum(tris.len(), |i| {
         let [a, b, c] = tris[i].map(|v| mesh.positions[v as usize].map(|x| x as f32 as f64));
-        dot(a, cross(b, c)) / 6.0
+        signed_volume(a, b, c)
     })
 }
 

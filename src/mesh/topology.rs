@@ -1,6 +1,6 @@
 //! Topology of an indexed triangle mesh, read off the vertex indices: undirected edges with the
-//! facets that use them, shells (facets connected through shared edges), vertex fans, and the
-//! loops that bound holes. `check` counts with it; `repair` decides with it.
+//! facets that use them, shells (facets connected through shared edges) with the edge counts that
+//! say whether each is closed, vertex fans, and the loops that bound holes. `check` counts with it; `repair` decides with it.
 //!
 //! Edges come from grouping the 3F half-edges by their (smaller, larger) vertex pair — a counting
 //! sort on the smaller vertex, then a sort of each small bucket — in linear time, faster than
@@ -248,6 +248,91 @@ impl Topology {
             });
         }
         loops
+    }
+}
+
+/// Edge counts of one shell: whether it is closed, and wound consistently.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ShellEdges {
+    /// Distinct edges of the shell.
+    pub edges: u64,
+    /// Edges with only one facet.
+    pub boundary: u64,
+    /// Edges shared by three or more facets.
+    pub non_manifold: u64,
+    /// Edges whose two facets traverse them in the same direction.
+    pub inconsistent: u64,
+}
+
+impl ShellEdges {
+    /// Every edge in exactly two facets: no boundary and no non-manifold edge.
+    pub fn closed(&self) -> bool {
+        self.boundary == 0 && self.non_manifold == 0
+    }
+
+    /// Closed and wound consistently: a shell with an inside, facing out or in.
+    pub fn solid(&self) -> bool {
+        self.closed() && self.inconsistent == 0
+    }
+}
+
+/// The shells of a mesh (facets connected through shared edges): each facet's shell, each
+/// shell's facets and its edge counts.
+#[derive(Debug, Clone)]
+pub struct Shells {
+    /// Shell of every facet, numbered as [`Topology::shells`] numbers them (`u32::MAX` for
+    /// facets with a repeated vertex).
+    pub of_facet: Vec<u32>,
+    /// Each shell's facets, in order.
+    pub members: Vec<Vec<u32>>,
+    /// Each shell's edge counts.
+    pub edges: Vec<ShellEdges>,
+}
+
+impl Shells {
+    /// The shells of `mesh`, whose topology is `topo`.
+    pub fn new(mesh: &Mesh, topo: &Topology) -> Shells {
+        let (of_facet, n) = topo.shells(mesh.triangle_count());
+        let mut members = vec![Vec::new(); n];
+        for (f, &s) in of_facet.iter().enumerate() {
+            if s != u32::MAX {
+                members[s as usize].push(f as u32);
+            }
+        }
+        // Every facet of an edge is active, so every edge belongs to its first facet's shell.
+        let mut edges = vec![ShellEdges::default(); n];
+        for e in 0..topo.edge_count() {
+            let hs = topo.edge(e);
+            let c = &mut edges[of_facet[(hs[0] / 3) as usize] as usize];
+            c.edges += 1;
+            match hs.len() {
+                1 => c.boundary += 1,
+                2 => c.inconsistent += u64::from(half_edge(mesh, hs[0]) == half_edge(mesh, hs[1])),
+                _ => c.non_manifold += 1,
+            }
+        }
+        Shells {
+            of_facet,
+            members,
+            edges,
+        }
+    }
+
+    /// Number of shells.
+    pub fn count(&self) -> usize {
+        self.members.len()
+    }
+
+    /// The whole mesh's edge counts: every edge belongs to exactly one shell.
+    pub fn total(&self) -> ShellEdges {
+        self.edges
+            .iter()
+            .fold(ShellEdges::default(), |t, e| ShellEdges {
+                edges: t.edges + e.edges,
+                boundary: t.boundary + e.boundary,
+                non_manifold: t.non_manifold + e.non_manifold,
+                inconsistent: t.inconsistent + e.inconsistent,
+            })
     }
 }
 

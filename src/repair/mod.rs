@@ -21,12 +21,11 @@ mod holes;
 pub mod remesh;
 mod split;
 
-use crate::check::{self, zero_area};
+use crate::check;
 use crate::error::Result;
-use crate::mesh::topology::Topology;
-use crate::mesh::{cross, dot, sub, Mesh};
+use crate::mesh::topology::{BoundaryLoop, Shells, Topology};
+use crate::mesh::{signed_volume, sub, Mesh};
 use crate::progress::Progress;
-use rayon::prelude::*;
 
 pub use file::{repair_file, FileRepairReport};
 pub use holes::PLANAR_REL;
@@ -113,6 +112,7 @@ impl Work {
         (&self.mesh, self.topo.as_ref().expect("just built"))
     }
 
+    /// Counts `count` changes of `kind` (none: nothing changed, the topology stays valid).
     fn note(&mut self, kind: &'static str, count: u64) {
         if count == 0 {
             return;
@@ -138,29 +138,149 @@ impl Work {
 
     /// Step 1 (run again after steps that can collapse facets).
     fn remove_bad_facets(&mut self) {
-        let nf = self.mesh.triangle_count();
-        let active = self.parts().1.active.clone();
-        let repeated = active.iter().filter(|a| !**a).count() as u64;
-        let zero: Vec<bool> = (0..nf)
-            .into_par_iter()
-            .map(|f| active[f] && zero_area(&self.mesh, f))
-            .collect();
-        let zero_count = zero.iter().filter(|z| **z).count() as u64;
         let (mesh, topo) = self.parts();
-        let dups = check::duplicate_facets(mesh, topo);
-        if repeated + zero_count + dups.len() as u64 == 0 {
+        let bad = check::FacetDefects::find(mesh, topo);
+        let zero_count = bad.zero_area_count();
+        if bad.repeated_vertex + zero_count + bad.duplicates.len() as u64 == 0 {
             return;
         }
-        let mut keep: Vec<bool> = (0..nf).map(|f| active[f] && !zero[f]).collect();
-        for &d in &dups {
+        let zero = &bad.zero_area;
+        let mut keep: Vec<bool> = (0..zero.len())
+            .map(|f| topo.active[f] && !zero[f])
+            .collect();
+        for &d in &bad.duplicates {
             keep[d as usize] = false;
         }
         // A duplicate of a zero-area facet is counted once, as zero-area.
-        let dup_count = dups.iter().filter(|&&d| !zero[d as usize]).count() as u64;
+        let dup_count = bad
+            .duplicates
+            .iter()
+            .filter(|&&d| !zero[d as usize])
+            .count() as u64;
         self.retain(&keep);
-        self.note("facets with a repeated vertex removed", repeated);
+        self.note("facets with a repeated vertex removed", bad.repeated_vertex);
         self.note("zero-area facets removed", zero_count);
         self.note("duplicate facets removed", dup_count);
+    }
+
+    /// Step 2: merges boundary vertices within `tol` of each other.
+    fn stitch_borders(&mut self, tol: f64) {
+        let merged = stitch(self, tol);
+        self.note("border vertices stitched", merged);
+        if merged > 0 {
+            self.remove_bad_facets();
+        }
+    }
+
+    /// Step 3: splits edges at T-junctions found with tolerance `tol` (a few rounds: a split
+    /// can leave a vertex on another edge).
+    fn split_t_junctions(&mut self, tol: f64) {
+        for _ in 0..4 {
+            let (mesh, topo) = self.parts();
+            let tjs = check::t_junctions(mesh, topo, tol);
+            if tjs.is_empty() {
+                break;
+            }
+            let n = split::split_t_junctions(&mut self.mesh, &tjs);
+            self.topo = None;
+            self.note("edges split at T-junctions", n);
+            if n == 0 {
+                break;
+            }
+        }
+        self.remove_bad_facets();
+    }
+
+    /// Step 4: separates shells that touch at a vertex or along a non-manifold edge.
+    fn separate_shells(&mut self) {
+        let topo = self
+            .topo
+            .take()
+            .unwrap_or_else(|| Topology::new(&self.mesh));
+        let (edges, copies) = split::split_non_manifold(&mut self.mesh, &topo);
+        if copies == 0 {
+            self.topo = Some(topo);
+        }
+        self.note(
+            "non-manifold edges separated",
+            if copies > 0 { edges } else { 0 },
+        );
+        self.note("vertices duplicated to separate touching shells", copies);
+    }
+
+    /// Step 6: fills the holes of shells with an inside; returns the holes neither method could
+    /// fill.
+    fn fill_holes(&mut self, fair: bool) -> Result<u64> {
+        let (mesh, topo) = self.parts();
+        let loops = holes_to_fill(mesh, topo);
+        if loops.is_empty() {
+            return Ok(0);
+        }
+        let st = holes::fill(&mut self.mesh, &loops, fair)?;
+        self.topo = None;
+        self.note("planar holes filled by triangulating the loop", st.planar);
+        self.note(
+            "curved holes filled by CGAL (triangulate, refine, fair)",
+            st.curved,
+        );
+        self.note("facets added to fill holes", st.facets_added);
+        Ok(st.failed)
+    }
+
+    /// Step 8: the shells still open, each with its holes; dropped with their facets when
+    /// `drop` is set.
+    fn open_shells(&mut self, drop: bool) -> Vec<OpenShell> {
+        let (mesh, topo) = self.parts();
+        let shells = Shells::new(mesh, topo);
+        let loops = topo.boundary_loops(mesh);
+        let mut open = Vec::new();
+        let mut dropped = vec![false; shells.count()];
+        for (s, e) in shells.edges.iter().enumerate() {
+            if e.closed() {
+                continue;
+            }
+            let fs = &shells.members[s];
+            let vs: std::collections::HashSet<u32> = fs
+                .iter()
+                .flat_map(|&f| mesh.indices[3 * f as usize..3 * f as usize + 3].to_vec())
+                .collect();
+            let hole_loops = loops
+                .iter()
+                .filter(|l| l.closed && vs.contains(&l.vertices[0]))
+                .count() as u64;
+            open.push(OpenShell {
+                facets: fs.len() as u64,
+                boundary_edges: e.boundary + e.non_manifold,
+                hole_loops,
+                dropped: drop,
+            });
+            dropped[s] = drop;
+        }
+        if drop && !open.is_empty() {
+            let keep: Vec<bool> = (shells.of_facet.iter())
+                .map(|&s| s != u32::MAX && !dropped[s as usize])
+                .collect();
+            let facets = keep.iter().filter(|k| !**k).count() as u64;
+            self.retain(&keep);
+            self.note("open shells dropped", open.len() as u64);
+            self.note("facets dropped with open shells", facets);
+        }
+        open
+    }
+
+    /// Step 8, when asked: rebuilds the part through an OpenVDB level set with voxels of
+    /// `voxel` mm; returns the level set's active voxels.
+    fn remesh(&mut self, voxel: f64) -> Result<u64> {
+        let before = self.mesh.triangle_count() as u64;
+        let (m, active) = remesh::remesh(&self.mesh, voxel)?;
+        self.mesh = m;
+        self.topo = None;
+        self.note("facets replaced by remeshing", before);
+        self.note(
+            "facets made by remeshing",
+            self.mesh.triangle_count() as u64,
+        );
+        Ok(active)
     }
 }
 
@@ -180,161 +300,48 @@ pub fn repair(
         .bounds()
         .map(|b| crate::mesh::norm(sub(b.max, b.min)))
         .unwrap_or(0.0);
-
     {
         let _s = progress.stage("removing degenerate and duplicate facets");
         w.remove_bad_facets();
     }
-
     {
         let _s = progress.stage("stitching borders");
-        let tol = opts
-            .stitch_tolerance
-            .unwrap_or(check::T_JUNCTION_REL * diag);
-        let merged = stitch(&mut w, tol);
-        w.note("border vertices stitched", merged);
-        if merged > 0 {
-            w.remove_bad_facets();
-        }
+        w.stitch_borders(
+            opts.stitch_tolerance
+                .unwrap_or(check::T_JUNCTION_REL * diag),
+        );
     }
-
     {
         let _s = progress.stage("splitting edges at T-junctions");
-        let tol = opts.stitch_tolerance.unwrap_or(0.0);
-        for _ in 0..4 {
-            let (mesh, topo) = w.parts();
-            let tjs = check::t_junctions(mesh, topo, tol);
-            if tjs.is_empty() {
-                break;
-            }
-            let n = split::split_t_junctions(&mut w.mesh, &tjs);
-            w.topo = None;
-            w.note("edges split at T-junctions", n);
-            if n == 0 {
-                break;
-            }
-        }
-        w.remove_bad_facets();
+        w.split_t_junctions(opts.stitch_tolerance.unwrap_or(0.0));
     }
-
     {
         let _s = progress.stage("separating shells at non-manifold edges and vertices");
-        let topo = w.topo.take().unwrap_or_else(|| Topology::new(&w.mesh));
-        let (edges, copies) = split::split_non_manifold(&mut w.mesh, &topo);
-        if copies == 0 {
-            w.topo = Some(topo);
-        }
-        w.note(
-            "non-manifold edges separated",
-            if copies > 0 { edges } else { 0 },
-        );
-        w.note("vertices duplicated to separate touching shells", copies);
+        w.separate_shells();
     }
-
     let non_orientable = {
         let _s = progress.stage("making winding consistent");
         orient_consistently(&mut w)
     };
-
-    let mut holes_left = 0;
-    if opts.fill_holes {
+    let holes_left = if opts.fill_holes {
         let _s = progress.stage("filling holes");
-        let nf = w.mesh.triangle_count();
-        let (mesh, topo) = w.parts();
-        let mut loops = topo.boundary_loops(mesh);
-        if !loops.is_empty() {
-            // A flat open sheet has no inside: filling its outline would only lay a second
-            // sheet on it. Such shells stay open (and are reported).
-            let (shell_of, n) = topo.shells(nf);
-            let members = check::shell_members(&shell_of, n);
-            let mut shell_of_vertex = vec![u32::MAX; mesh.vertex_count()];
-            for (f, &s) in shell_of.iter().enumerate() {
-                for k in 0..3 {
-                    shell_of_vertex[mesh.indices[3 * f + k] as usize] = s;
-                }
-            }
-            let flat: Vec<bool> = members.iter().map(|m| holes::is_flat(mesh, m)).collect();
-            loops.retain(|l| {
-                let s = shell_of_vertex[l.vertices[0] as usize];
-                s == u32::MAX || !flat[s as usize]
-            });
-        }
-        if !loops.is_empty() {
-            let st = holes::fill(&mut w.mesh, &loops, opts.fair)?;
-            w.topo = None;
-            w.note("planar holes filled by triangulating the loop", st.planar);
-            w.note(
-                "curved holes filled by CGAL (triangulate, refine, fair)",
-                st.curved,
-            );
-            w.note("facets added to fill holes", st.facets_added);
-            holes_left = st.failed;
-        }
-    }
-
+        w.fill_holes(opts.fair)?
+    } else {
+        0
+    };
     {
         let _s = progress.stage("turning shells outward");
         let flipped = orient_outward(&mut w);
         w.note("shells turned outward", flipped);
     }
-
-    let mut open_shells = Vec::new();
-    {
-        let nf = w.mesh.triangle_count();
-        let (mesh, topo) = w.parts();
-        let (shell_of, n) = topo.shells(nf);
-        let mut boundary = vec![0u64; n];
-        for e in 0..topo.edge_count() {
-            let hs = topo.edge(e);
-            if hs.len() != 2 {
-                boundary[shell_of[(hs[0] / 3) as usize] as usize] += 1;
-            }
+    let open_shells = w.open_shells(opts.drop_open_shells);
+    let remesh_active = match opts.remesh {
+        Some(voxel) => {
+            let _s = progress.stage("remeshing through OpenVDB");
+            Some(w.remesh(voxel)?)
         }
-        let loops = topo.boundary_loops(mesh);
-        let members = check::shell_members(&shell_of, n);
-        let mut drop = vec![false; n];
-        for s in 0..n {
-            if boundary[s] > 0 {
-                let vs: std::collections::HashSet<u32> = members[s]
-                    .iter()
-                    .flat_map(|&f| mesh.indices[3 * f as usize..3 * f as usize + 3].to_vec())
-                    .collect();
-                let hole_loops = loops
-                    .iter()
-                    .filter(|l| l.closed && vs.contains(&l.vertices[0]))
-                    .count() as u64;
-                open_shells.push(OpenShell {
-                    facets: members[s].len() as u64,
-                    boundary_edges: boundary[s],
-                    hole_loops,
-                    dropped: opts.drop_open_shells,
-                });
-                drop[s] = opts.drop_open_shells;
-            }
-        }
-        if opts.drop_open_shells && drop.iter().any(|d| *d) {
-            let keep: Vec<bool> = (0..nf)
-                .map(|f| shell_of[f] != u32::MAX && !drop[shell_of[f] as usize])
-                .collect();
-            let dropped = keep.iter().filter(|k| !**k).count() as u64;
-            w.retain(&keep);
-            w.note("open shells dropped", open_shells.len() as u64);
-            w.note("facets dropped with open shells", dropped);
-        }
-    }
-
-    let mut remesh_active = None;
-    if let Some(voxel) = opts.remesh {
-        let _s = progress.stage("remeshing through OpenVDB");
-        let before = w.mesh.triangle_count() as u64;
-        let (m, active) = remesh::remesh(&w.mesh, voxel)?;
-        w.mesh = m;
-        w.topo = None;
-        remesh_active = Some(active);
-        w.note("facets replaced by remeshing", before);
-        w.note("facets made by remeshing", w.mesh.triangle_count() as u64);
-    }
-
+        None => None,
+    };
     let removed = compact(&mut w.mesh);
     w.note("unreferenced vertices removed", removed);
 
@@ -349,6 +356,31 @@ pub fn repair(
             remesh_active_voxels: remesh_active,
         },
     ))
+}
+
+/// The boundary loops to fill: every one but the outlines of flat open sheets. A flat open sheet
+/// has no inside: filling its outline would only lay a second sheet on it. Such shells stay open
+/// (and are reported).
+fn holes_to_fill(mesh: &Mesh, topo: &Topology) -> Vec<BoundaryLoop> {
+    let mut loops = topo.boundary_loops(mesh);
+    if loops.is_empty() {
+        return loops;
+    }
+    let shells = Shells::new(mesh, topo);
+    let mut shell_of_vertex = vec![u32::MAX; mesh.vertex_count()];
+    for (f, &s) in shells.of_facet.iter().enumerate() {
+        for k in 0..3 {
+            shell_of_vertex[mesh.indices[3 * f + k] as usize] = s;
+        }
+    }
+    let flat: Vec<bool> = (shells.members.iter())
+        .map(|m| holes::is_flat(mesh, m))
+        .collect();
+    loops.retain(|l| {
+        let s = shell_of_vertex[l.vertices[0] as usize];
+        s == u32::MAX || !flat[s as usize]
+    });
+    loops
 }
 
 /// Merges boundary vertices within `tol` of each other. Returns vertices merged away.
@@ -426,32 +458,22 @@ fn orient_consistently(w: &mut Work) -> u64 {
 
 /// Flips closed, consistently wound shells whose facing disagrees with their nesting depth.
 fn orient_outward(w: &mut Work) -> u64 {
-    let nf = w.mesh.triangle_count();
     let (mesh, topo) = w.parts();
-    let (shell_of, n) = topo.shells(nf);
-    let mut closed = vec![true; n];
-    for e in 0..topo.edge_count() {
-        let hs = topo.edge(e);
-        let s = shell_of[(hs[0] / 3) as usize] as usize;
-        let he = |h: u32| crate::mesh::topology::half_edge(mesh, h);
-        if hs.len() != 2 || he(hs[0]) == he(hs[1]) {
-            closed[s] = false;
-        }
-    }
-    let members = check::shell_members(&shell_of, n);
-    let depth = check::nesting(mesh, &members, &closed);
+    let shells = Shells::new(mesh, topo);
+    let solid: Vec<bool> = shells.edges.iter().map(|e| e.solid()).collect();
+    let depth = check::nesting(mesh, &shells.members, &solid);
     let mut flipped = 0;
-    for s in 0..n {
-        let Some(d) = depth[s] else { continue };
-        let vol: f64 = members[s]
+    for (fs, d) in shells.members.iter().zip(depth) {
+        let Some(d) = d else { continue };
+        let vol: f64 = fs
             .iter()
             .map(|&f| {
                 let [a, b, c] = w.mesh.triangle(f as usize);
-                dot(a, cross(b, c)) / 6.0
+                signed_volume(a, b, c)
             })
             .sum();
         if (vol > 0.0) != (d % 2 == 0) && vol != 0.0 {
-            for &f in &members[s] {
+            for &f in fs {
                 w.mesh.indices.swap(3 * f as usize + 1, 3 * f as usize + 2);
             }
             flipped += 1;
