@@ -1,17 +1,18 @@
-//! Compiles the C++ shims and links the Debian packages behind them. No translation unit parses
-//! both OpenVDB's and CGAL's headers.
+//! Compiles the C++ shims and links the Debian packages behind them: one bridge per library
+//! (`src/ffi/vdb.rs` with `cpp/vdb.h`, `src/ffi/cgal.rs` with `cpp/cgal.h`), each implemented by
+//! a few small translation units so that no unit parses both OpenVDB's and CGAL's headers.
 
 use std::path::Path;
 
-/// The C++ headers.
-const HEADERS: [&str; 4] = [
-    "cpp/vdb.h",
-    "cpp/vdb_filter.h",
-    "cpp/vdb_remesh.h",
-    "cpp/cgal.h",
+/// The C++ headers: one per library, and what the OpenVDB units share.
+const HEADERS: [&str; 3] = ["cpp/vdb.h", "cpp/vdb_internal.h", "cpp/cgal.h"];
+/// The translation units behind `cpp/vdb.h`.
+const VDB_UNITS: [&str; 4] = [
+    "cpp/vdb_grid.cc",
+    "cpp/vdb_from_mesh.cc",
+    "cpp/vdb_filter.cc",
+    "cpp/vdb_mesh.cc",
 ];
-/// The translation units behind the OpenVDB bridges.
-const VDB_UNITS: [&str; 3] = ["cpp/vdb.cc", "cpp/vdb_filter.cc", "cpp/vdb_remesh.cc"];
 /// The translation units behind `cpp/cgal.h`.
 const CGAL_CHECK_UNIT: &str = "cpp/cgal_check.cc";
 const CGAL_REPAIR_UNIT: &str = "cpp/cgal_repair.cc";
@@ -47,21 +48,10 @@ fn main() {
             .include("/usr/include/eigen3");
     };
 
+    // OpenVDB: one bridge, one translation unit per operation.
     let mut vdb = cxx_build::bridge("src/ffi/vdb.rs");
     flags(&mut vdb);
-    vdb.file("cpp/vdb.cc").compile("latvox_vdb");
-
-    let mut filter = cxx_build::bridge("src/ffi/vdb_filter.rs");
-    flags(&mut filter);
-    filter
-        .file("cpp/vdb_filter.cc")
-        .compile("latvox_vdb_filter");
-
-    let mut vdb_remesh = cxx_build::bridge("src/ffi/vdb_remesh.rs");
-    flags(&mut vdb_remesh);
-    vdb_remesh
-        .file("cpp/vdb_remesh.cc")
-        .compile("latvox_vdb_remesh");
+    vdb.files(VDB_UNITS).compile("latvox_vdb");
 
     // CGAL: one bridge; the checks here, the repair steps below with settings of their own.
     let mut cgal = cxx_build::bridge("src/ffi/cgal.rs");
@@ -87,16 +77,11 @@ fn main() {
     for lib in ["openvdb", "tbb", "Imath-3_1", "gmp", "mpfr"] {
         println!("cargo:rustc-link-lib={lib}");
     }
-    for f in [
-        "src/ffi/vdb.rs",
-        "src/ffi/vdb_filter.rs",
-        "src/ffi/vdb_remesh.rs",
-        "src/ffi/cgal.rs",
-    ]
-    .into_iter()
-    .chain(HEADERS)
-    .chain(VDB_UNITS)
-    .chain([CGAL_CHECK_UNIT, CGAL_REPAIR_UNIT])
+    for f in ["src/ffi/vdb.rs", "src/ffi/cgal.rs"]
+        .into_iter()
+        .chain(HEADERS)
+        .chain(VDB_UNITS)
+        .chain([CGAL_CHECK_UNIT, CGAL_REPAIR_UNIT])
     {
         println!("cargo:rerun-if-changed={f}");
     }

@@ -2,9 +2,9 @@
 
 use super::{write_json, yes};
 use clap::Args;
+use latvox::grid::Smoothing;
 use latvox::io::stl::StlFormat;
 use latvox::topo::job::{self, TopoJob};
-use latvox::topo::volume::Smoothing;
 use latvox::topo::{CleanOptions, Density};
 use latvox::{Error, Result};
 use std::path::PathBuf;

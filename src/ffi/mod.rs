@@ -1,11 +1,10 @@
-//! Where Rust calls C++: [`cgal`] is CGAL's one bridge (`cpp/cgal.h`), implemented by small
-//! translation units of its own; OpenVDB is reached through [`vdb`], [`vdb_filter`] and
-//! [`vdb_remesh`]. Nothing here is public; safe wrappers live in `grid`, `verify` and `repair`.
+//! Where Rust calls C++: one bridge per library, [`vdb`] (OpenVDB, `cpp/vdb.h`) and [`cgal`]
+//! (CGAL, `cpp/cgal.h`), each header implemented by a few small translation units, none of which
+//! parses both libraries' headers. Nothing here is public, and no `cxx` type leaves this module:
+//! safe wrappers live in `grid`, `verify` and `repair`.
 
 pub(crate) mod cgal;
 pub(crate) mod vdb;
-pub(crate) mod vdb_filter;
-pub(crate) mod vdb_remesh;
 
 use crate::error::{Error, Result};
 

@@ -8,6 +8,7 @@ use super::{extrude, volume, Density};
 use crate::cad::bspline::Periodic;
 use crate::cad::fit;
 use crate::error::Result;
+use crate::grid::Smoothing;
 use crate::mesh::Mesh;
 use crate::progress::Progress;
 use crate::verify::{verify, Verification};
@@ -27,7 +28,7 @@ pub struct TopoJob {
     pub self_intersection: bool,
     /// 3D: OpenVDB level-set smoothing passes (0: none) and the flow.
     pub smooth_iterations: u32,
-    pub smoothing: volume::Smoothing,
+    pub smoothing: Smoothing,
 }
 
 /// One boundary loop's fits.
