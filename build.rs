@@ -1,7 +1,21 @@
-//! Compiles the C++ shims (one translation unit per library, so OpenVDB users never parse CGAL
-//! headers) and links the Debian packages behind them.
+//! Compiles the C++ shims and links the Debian packages behind them: one bridge per library
+//! (`src/ffi/vdb.rs` with `cpp/vdb.h`, `src/ffi/cgal.rs` with `cpp/cgal.h`), each implemented by
+//! a few small translation units so that no unit parses both OpenVDB's and CGAL's headers.
 
 use std::path::Path;
+
+/// The C++ headers: one per library, and what the OpenVDB units share.
+const HEADERS: [&str; 3] = ["cpp/vdb.h", "cpp/vdb_internal.h", "cpp/cgal.h"];
+/// The translation units behind `cpp/vdb.h`.
+const VDB_UNITS: [&str; 4] = [
+    "cpp/vdb_grid.cc",
+    "cpp/vdb_from_mesh.cc",
+    "cpp/vdb_filter.cc",
+    "cpp/vdb_mesh.cc",
+];
+/// The translation units behind `cpp/cgal.h`.
+const CGAL_CHECK_UNIT: &str = "cpp/cgal_check.cc";
+const CGAL_REPAIR_UNIT: &str = "cpp/cgal_repair.cc";
 
 const INSTALL_HINT: &str = "run `bash scripts/install-deps.sh` (Debian bookworm: libopenvdb-dev, libcgal-dev, libtbb-dev, libgmp-dev, libmpfr-dev, libeigen3-dev)";
 
@@ -34,61 +48,41 @@ fn main() {
             .include("/usr/include/eigen3");
     };
 
+    // OpenVDB: one bridge, one translation unit per operation.
     let mut vdb = cxx_build::bridge("src/ffi/vdb.rs");
     flags(&mut vdb);
-    vdb.file("cpp/vdb.cc").compile("latvox_vdb");
+    vdb.files(VDB_UNITS).compile("latvox_vdb");
 
-    let mut filter = cxx_build::bridge("src/ffi/vdb_filter.rs");
-    flags(&mut filter);
-    filter
-        .file("cpp/vdb_filter.cc")
-        .compile("latvox_vdb_filter");
-
+    // CGAL: one bridge; the checks here, the repair steps below with settings of their own.
     let mut cgal = cxx_build::bridge("src/ffi/cgal.rs");
     flags(&mut cgal);
     cgal.define("CGAL_LINKED_WITH_TBB", None)
-        .file("cpp/cgal.cc")
+        .file(CGAL_CHECK_UNIT)
         .compile("latvox_cgal");
 
     // CGAL's own precondition checks are compiled out here: in the self-intersection search they
     // cost over a quarter of its CPU time (a whole-mesh triangle test on every call, degeneracy
     // tests on every triangle and segment compared), and this code meets them by construction
     // (triangles with three distinct vertices, hole edges checked to be border edges).
-    let mut cgal_repair = cxx_build::bridge("src/ffi/cgal_repair.rs");
+    // No bridge of its own: the same CGAL bridge's generated header, on cxx's include path.
+    let mut cgal_repair = cxx_build::bridges(std::iter::empty::<&str>());
     flags(&mut cgal_repair);
     cgal_repair
         .define("CGAL_LINKED_WITH_TBB", None)
         .define("CGAL_EIGEN3_ENABLED", None)
         .define("CGAL_NDEBUG", None)
-        .file("cpp/cgal_repair.cc")
+        .file(CGAL_REPAIR_UNIT)
         .compile("latvox_cgal_repair");
-
-    let mut vdb_remesh = cxx_build::bridge("src/ffi/vdb_remesh.rs");
-    flags(&mut vdb_remesh);
-    vdb_remesh
-        .file("cpp/vdb_remesh.cc")
-        .compile("latvox_vdb_remesh");
 
     for lib in ["openvdb", "tbb", "Imath-3_1", "gmp", "mpfr"] {
         println!("cargo:rustc-link-lib={lib}");
     }
-    for f in [
-        "src/ffi/vdb.rs",
-        "src/ffi/cgal.rs",
-        "cpp/vdb.h",
-        "cpp/vdb.cc",
-        "cpp/cgal.h",
-        "cpp/cgal.cc",
-        "src/ffi/vdb_filter.rs",
-        "cpp/vdb_filter.h",
-        "cpp/vdb_filter.cc",
-        "src/ffi/cgal_repair.rs",
-        "cpp/cgal_repair.h",
-        "cpp/cgal_repair.cc",
-        "src/ffi/vdb_remesh.rs",
-        "cpp/vdb_remesh.h",
-        "cpp/vdb_remesh.cc",
-    ] {
+    for f in ["src/ffi/vdb.rs", "src/ffi/cgal.rs"]
+        .into_iter()
+        .chain(HEADERS)
+        .chain(VDB_UNITS)
+        .chain([CGAL_CHECK_UNIT, CGAL_REPAIR_UNIT])
+    {
         println!("cargo:rerun-if-changed={f}");
     }
 }

@@ -1,4 +1,6 @@
-// CGAL side of the bridge: closed-mesh measures and validity checks on an indexed triangle soup.
+// CGAL side of the bridge, on indexed triangle soups: closed-mesh measures and validity checks
+// (cgal_check.cc); self-intersections of any soup and hole filling, the repair steps
+// (cgal_repair.cc, compiled apart with its own CGAL settings). One header for the whole library.
 #pragma once
 #include <cstdint>
 #include "rust/cxx.h"
@@ -6,12 +8,21 @@
 namespace latvox {
 
 struct CgalReport;
+struct SoupIntersections;
+struct HoleFill;
 
+// cgal_check.cc
 CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
                       bool self_intersection, bool parallel);
 
-rust::Vec<uint32_t> cgal_self_intersections(rust::Slice<const float> positions,
-                                            rust::Slice<const uint32_t> indices,
-                                            std::size_t limit);
+// cgal_repair.cc
+SoupIntersections cgal_soup_self_intersections(rust::Slice<const float> positions,
+                                               rust::Slice<const uint32_t> indices,
+                                               rust::Slice<const uint32_t> tile_faces,
+                                               rust::Slice<const uint32_t> tile_starts,
+                                               std::size_t limit);
+
+HoleFill cgal_fill_holes(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
+                         rust::Slice<const uint32_t> hole_starts, bool fair);
 
 }  // namespace latvox

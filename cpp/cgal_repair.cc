@@ -8,7 +8,8 @@
 //    are counted once. Same mesh, same predicates: the same pairs as one whole-mesh search;
 //  - hole filling: triangulate_refine_and_fair_hole on the border cycles named by the caller,
 //    returning only what was added, so the caller keeps its own vertex and facet numbering.
-#include "cgal_repair.h"
+// Compiled apart from cgal_check.cc, with CGAL's precondition checks off (see build.rs).
+#include "cgal.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
@@ -26,7 +27,7 @@
 #include <utility>
 #include <vector>
 
-#include "latvox/src/ffi/cgal_repair.rs.h"
+#include "latvox/src/ffi/cgal.rs.h"
 
 namespace latvox {
 

@@ -1,5 +1,8 @@
-// OpenVDB side of the bridge: sparse narrow-band level sets built from Rust-sampled leaf blocks,
-// meshed with volumeToMesh. Only plain slices and opaque handles cross the boundary.
+// OpenVDB side of the bridge: sparse narrow-band level sets, built from leaf blocks sampled in
+// Rust or from triangles, smoothed, meshed with volumeToMesh and written as .vdb. Only plain
+// slices and opaque handles cross the boundary. One header for the whole library; the
+// definitions live in one small translation unit per operation (vdb_grid.cc, vdb_from_mesh.cc,
+// vdb_filter.cc, vdb_mesh.cc), which share vdb_internal.h.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -7,7 +10,7 @@
 
 namespace latvox {
 
-// Opaque handle: the OpenVDB grid lives in Impl, defined only in vdb.cc.
+// Opaque handle: the OpenVDB grid lives in Impl, defined only in vdb_internal.h.
 struct VdbGrid {
   struct Impl;
   std::unique_ptr<Impl> impl;
@@ -15,6 +18,10 @@ struct VdbGrid {
   ~VdbGrid();
 };
 
+struct Extraction;
+enum class SmoothingMode : uint8_t;
+
+// vdb_grid.cc: the grid and what it holds.
 void vdb_set_threads(std::size_t threads);
 
 std::unique_ptr<VdbGrid> vdb_grid_from_leaves(double voxel_size, rust::Slice<const double> origin,
@@ -22,16 +29,25 @@ std::unique_ptr<VdbGrid> vdb_grid_from_leaves(double voxel_size, rust::Slice<con
                                               rust::Slice<const int32_t> leaf_origins,
                                               rust::Slice<const float> values);
 
-struct Extraction;
-
-void vdb_volume_to_mesh(const VdbGrid& grid, double adaptivity, rust::Vec<float>& positions,
-                        rust::Vec<uint32_t>& indices);
-
-void vdb_extract(const VdbGrid& grid, Extraction& out);
-
 uint64_t vdb_active_voxels(const VdbGrid& grid);
-uint64_t vdb_leaf_count(const VdbGrid& grid);
 uint64_t vdb_memory_bytes(const VdbGrid& grid);
 void vdb_write(const VdbGrid& grid, rust::Str path);
+
+// vdb_from_mesh.cc: triangles to a level set (meshToLevelSet); index (0,0,0) at the origin.
+std::unique_ptr<VdbGrid> vdb_grid_from_mesh(rust::Slice<const float> positions,
+                                            rust::Slice<const uint32_t> indices,
+                                            double voxel_size, float half_width);
+
+// vdb_filter.cc: the level set rebuilt as a signed distance `half_width` voxels each side of
+// the surface, then `iterations` passes of LevelSetFilter.
+std::unique_ptr<VdbGrid> vdb_smoothed(const VdbGrid& grid, SmoothingMode mode,
+                                      uint32_t iterations, float half_width);
+
+// vdb_mesh.cc: the iso-surface `isovalue` (world units) as outward-wound triangles, and the
+// zero iso-surface in index space with every point tied to its voxel.
+void vdb_volume_to_mesh(const VdbGrid& grid, double isovalue, double adaptivity,
+                        rust::Vec<float>& positions, rust::Vec<uint32_t>& indices);
+
+void vdb_extract(const VdbGrid& grid, Extraction& out);
 
 }  // namespace latvox

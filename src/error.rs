@@ -70,13 +70,6 @@ impl Error {
         }
     }
 
-    pub(crate) fn backend(context: &'static str, e: cxx::Exception) -> Self {
-        Error::Backend {
-            context,
-            message: e.what().to_string(),
-        }
-    }
-
     /// Process exit code for this error: 2 for bad input, 3 for a failure inside a backend.
     pub fn exit_code(&self) -> i32 {
         match self {

@@ -3,8 +3,9 @@
 //! an independent second measurement of every mesh latvox writes.
 
 use crate::check::Verdict;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::ffi::cgal::ffi;
+use crate::ffi::Backend;
 use crate::mesh::Mesh;
 
 /// What CGAL found.
@@ -50,7 +51,7 @@ pub fn verify(mesh: &Mesh, self_intersection: bool) -> Result<Verification> {
 /// checks that run beside other work).
 pub fn verify_on(mesh: &Mesh, self_intersection: bool, parallel: bool) -> Result<Verification> {
     let r = ffi::cgal_check(&mesh.positions, &mesh.indices, self_intersection, parallel)
-        .map_err(|e| Error::backend("CGAL mesh check", e))?;
+        .backend("CGAL mesh check")?;
     Ok(Verification {
         manifold: r.valid_polygon_mesh,
         closed: r.closed,
@@ -64,12 +65,4 @@ pub fn verify_on(mesh: &Mesh, self_intersection: bool, parallel: bool) -> Result
         border_edges: r.border_edges,
         components: r.components,
     })
-}
-
-/// Up to `limit` pairs of intersecting triangles (indices into `mesh`), found by CGAL.
-/// Needs an oriented 2-manifold mesh (face indices are only meaningful then).
-pub fn self_intersections(mesh: &Mesh, limit: usize) -> Result<Vec<(u32, u32)>> {
-    let flat = ffi::cgal_self_intersections(&mesh.positions, &mesh.indices, limit)
-        .map_err(|e| Error::backend("CGAL self-intersection search", e))?;
-    Ok(flat.chunks_exact(2).map(|p| (p[0], p[1])).collect())
 }

@@ -4,8 +4,8 @@
 use super::out::outln;
 use super::{cgal_findings, write_json};
 use clap::Args;
+use latvox::grid::Smoothing;
 use latvox::interpret::job;
-use latvox::interpret::volume::Smoothing;
 use latvox::interpret::{interpret_file, TopoFiles, TopoOptions, TopoPart};
 use latvox::progress::Progress;
 use latvox::Result;

@@ -1,4 +1,5 @@
-//! The OpenVDB half of the C++ bridge. Raw declarations only; `crate::grid` wraps them safely.
+//! The OpenVDB bridge (`cpp/vdb.h`, implemented by `cpp/vdb_*.cc`). Raw declarations and the
+//! owned grid handle only; `crate::grid` wraps them safely.
 
 #[cxx::bridge(namespace = "latvox")]
 pub(crate) mod ffi {
@@ -16,6 +17,15 @@ pub(crate) mod ffi {
         quads: Vec<u32>,
     }
 
+    /// One pass of OpenVDB's `LevelSetFilter`.
+    #[repr(u8)]
+    enum SmoothingMode {
+        Gaussian,
+        MeanCurvature,
+        Laplacian,
+        Mean,
+    }
+
     unsafe extern "C++" {
         include!("latvox/cpp/vdb.h");
 
@@ -29,15 +39,27 @@ pub(crate) mod ffi {
             leaf_origins: &[i32],
             values: &[f32],
         ) -> Result<UniquePtr<VdbGrid>>;
+        fn vdb_grid_from_mesh(
+            positions: &[f32],
+            indices: &[u32],
+            voxel_size: f64,
+            half_width: f32,
+        ) -> Result<UniquePtr<VdbGrid>>;
+        fn vdb_smoothed(
+            grid: &VdbGrid,
+            mode: SmoothingMode,
+            iterations: u32,
+            half_width: f32,
+        ) -> Result<UniquePtr<VdbGrid>>;
         fn vdb_volume_to_mesh(
             grid: &VdbGrid,
+            isovalue: f64,
             adaptivity: f64,
             positions: &mut Vec<f32>,
             indices: &mut Vec<u32>,
         ) -> Result<()>;
         fn vdb_extract(grid: &VdbGrid, out: &mut Extraction) -> Result<()>;
         fn vdb_active_voxels(grid: &VdbGrid) -> u64;
-        fn vdb_leaf_count(grid: &VdbGrid) -> u64;
         fn vdb_memory_bytes(grid: &VdbGrid) -> u64;
         fn vdb_write(grid: &VdbGrid, path: &str) -> Result<()>;
     }
@@ -46,3 +68,20 @@ pub(crate) mod ffi {
 // SAFETY: an OpenVDB grid is immutable once built here; const methods are thread-safe.
 unsafe impl Send for ffi::VdbGrid {}
 unsafe impl Sync for ffi::VdbGrid {}
+
+/// An OpenVDB grid owned by Rust. Dereferences to the opaque grid the bridge functions take.
+pub(crate) struct OwnedGrid(cxx::UniquePtr<ffi::VdbGrid>);
+
+impl From<cxx::UniquePtr<ffi::VdbGrid>> for OwnedGrid {
+    fn from(p: cxx::UniquePtr<ffi::VdbGrid>) -> Self {
+        OwnedGrid(p)
+    }
+}
+
+impl std::ops::Deref for OwnedGrid {
+    type Target = ffi::VdbGrid;
+    fn deref(&self) -> &ffi::VdbGrid {
+        // Never null: the C++ side returns a new grid or throws.
+        &self.0
+    }
+}

@@ -4,9 +4,9 @@
 //! caller's to write.
 
 use super::job::{self, TopoJob, TopoResult};
-use super::volume::Smoothing;
 use super::{images, CleanOptions, Density};
 use crate::error::{Error, Result};
+use crate::grid::Smoothing;
 use crate::io::atomic::{check_writable, write_atomic};
 use crate::io::sink::MeshFile;
 use crate::progress::Progress;

@@ -10,6 +10,7 @@ use crate::cad::fit;
 use crate::check::cgal::{verify, Verification};
 use crate::check::Verdict;
 use crate::error::Result;
+use crate::grid::Smoothing;
 use crate::mesh::Mesh;
 use crate::progress::Progress;
 use rayon::prelude::*;
@@ -31,7 +32,7 @@ pub struct TopoJob {
     /// 3D: OpenVDB level-set smoothing passes (0: none) and the flow.
     pub smooth_iterations: u32,
     /// The level-set flow used for smoothing.
-    pub smoothing: volume::Smoothing,
+    pub smoothing: Smoothing,
 }
 
 /// One boundary loop's fits.

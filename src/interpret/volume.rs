@@ -1,7 +1,7 @@
-//! 3D results to a mesh through latvox's own pipeline (optionally smoothed by OpenVDB's
-//! level-set filter, [`Smoothed`]): the filtered density grid is a
+//! 3D results to a mesh through latvox's own pipeline: the filtered density grid is a
 //! [`Field`] (trilinear between voxel centres, void beyond the domain), sampled into an OpenVDB
-//! narrow-band level set by [`Grid::sample`] and meshed by [`Grid::to_mesh`].
+//! narrow-band level set by [`Grid::sample`] and meshed by [`Grid::to_mesh`]; optionally
+//! smoothed first by OpenVDB's level-set filter ([`Smoothed`], [`Grid::smoothed`]).
 //!
 //! Value: `(level − ρ) / |∇ρ|`, a first-order signed distance to the iso-surface `ρ = level`.
 //! Clearance: with ρ in [0, top] each partial derivative of the trilinear interpolant is at most
@@ -9,11 +9,10 @@
 //! bound that never overestimates, as block culling requires.
 
 use super::raster::Raster;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::field::{Aabb, Field, Intersection, Vec3};
-use crate::grid::{Grid, GridSpec};
+use crate::grid::{Grid, GridSpec, Smoothing};
 use crate::mesh::Mesh;
-use rayon::prelude::*;
 
 /// The iso-surface `ρ = level` of a 3D raster.
 pub struct DensityField<'a> {
@@ -118,6 +117,12 @@ impl Field for DensityField<'_> {
 
 /// Meshes the iso-surface of a 3D raster at `level` with OpenVDB, at the raster's voxel size.
 pub fn mesh(grid: &Raster, level: f64) -> Result<Mesh> {
+    sample(grid, level)?.to_mesh(0.0)
+}
+
+/// The iso-surface of a 3D raster at `level` as a narrow-band level set at the raster's voxel
+/// size.
+fn sample(grid: &Raster, level: f64) -> Result<Grid> {
     let top = grid.data.iter().copied().fold(1.0f64, f64::max);
     let f = DensityField { grid, level, top };
     let h = grid.h;
@@ -129,80 +134,29 @@ pub fn mesh(grid: &Raster, level: f64) -> Result<Mesh> {
     // Clipped by the domain box, whose exact distance closes the part where it meets the
     // domain's faces (the density alone drops to void there without a distance-like ramp).
     let clipped = Intersection { a: f, b: bounds };
-    let g = Grid::sample(&clipped, spec)?;
-    g.to_mesh(0.0)
+    Grid::sample(&clipped, spec)
 }
 
-/// OpenVDB's level-set smoothing flows (`LevelSetFilter`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Smoothing {
-    /// Gaussian filter of the level set (OpenVDB's `gaussian`).
-    Gaussian,
-    /// Mean-curvature flow (`meanCurvature`).
-    MeanCurvature,
-    /// Laplacian flow (`laplacian`).
-    Laplacian,
-    /// Mean (box) filter (`mean`).
-    Mean,
-}
+/// Half width, in voxels, of the smoothed level set's band: room for the filter's stencils and
+/// for the offsets of up to three voxels that keep the part's volume.
+const SMOOTHED_BAND: f64 = 6.0;
 
 /// A 3D raster's iso-surface at `level`, smoothed by `iterations` passes of OpenVDB's level-set
-/// filter: the density field, sampled as a [`Field`] at the voxel centres, is rebuilt by OpenVDB
-/// as a narrow-band level set and smoothed (`cpp/vdb_filter.cc`). Mesh it with
+/// filter ([`Grid::smoothed`]) on the level set that [`mesh`] would mesh. Mesh it with
 /// [`Smoothed::mesh`] at any offset of the surface.
 pub struct Smoothed {
-    inner: cxx::UniquePtr<crate::ffi::vdb_filter::ffi::SmoothedLevelSet>,
+    grid: Grid,
 }
 
 impl Smoothed {
     /// Builds the level set of `grid`'s iso-surface at `level` and smooths it.
     pub fn new(grid: &Raster, level: f64, mode: Smoothing, iterations: u32) -> Result<Smoothed> {
-        let top = grid.data.iter().copied().fold(1.0f64, f64::max);
-        let f = DensityField { grid, level, top };
-        let [nx, ny, nz] = grid.n;
-        let h = grid.h;
-        let values: Vec<f32> = (0..nx * ny * nz)
-            .into_par_iter()
-            .map(|i| {
-                let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
-                f.value([
-                    (x as f64 + 0.5) * h,
-                    (y as f64 + 0.5) * h,
-                    (z as f64 + 0.5) * h,
-                ]) as f32
-            })
-            .collect();
-        let mode = match mode {
-            Smoothing::Gaussian => 1,
-            Smoothing::MeanCurvature => 2,
-            Smoothing::Laplacian => 3,
-            Smoothing::Mean => 4,
-        };
-        let dims = [nx as u32, ny as u32, nz as u32];
-        let inner = crate::ffi::vdb_filter::ffi::vdb_smooth(
-            &values,
-            &dims,
-            h,
-            &[0.0; 3],
-            (3.0 * h) as f32,
-            mode,
-            iterations,
-        )
-        .map_err(|e| Error::backend("smoothing the level set (OpenVDB LevelSetFilter)", e))?;
-        Ok(Smoothed { inner })
+        let grid = sample(grid, level)?.smoothed(mode, iterations, SMOOTHED_BAND)?;
+        Ok(Smoothed { grid })
     }
 
     /// The smoothed surface offset outwards by `offset` mm (negative: inwards), meshed.
     pub fn mesh(&self, offset: f64) -> Result<Mesh> {
-        let (mut positions, mut indices) = (Vec::new(), Vec::new());
-        crate::ffi::vdb_filter::ffi::vdb_smoothed_mesh(
-            &self.inner,
-            offset,
-            &mut positions,
-            &mut indices,
-        )
-        .map_err(|e| Error::backend("meshing the smoothed level set", e))?;
-        Ok(Mesh { positions, indices })
+        self.grid.to_mesh_at(offset, 0.0)
     }
 }

@@ -1,8 +1,9 @@
-//! Safe wrappers over the CGAL repair bridge: self-intersections of any facet subset, and hole
+//! Safe wrappers over CGAL's repair steps: self-intersections of any facet subset, and hole
 //! filling by triangulation, refinement and fairing.
 
-use crate::error::{Error, Result};
-use crate::ffi::cgal_repair::ffi;
+use crate::error::Result;
+use crate::ffi::cgal::ffi;
+use crate::ffi::Backend;
 use crate::mesh::Mesh;
 use rayon::prelude::*;
 
@@ -51,7 +52,7 @@ pub fn soup_self_intersections_in_tiles(
         &tile_starts,
         limit,
     )
-    .map_err(|e| Error::backend("CGAL self-intersection search", e))?;
+    .backend("CGAL self-intersection search")?;
     let pairs = r
         .pairs
         .chunks_exact(2)
@@ -173,7 +174,7 @@ pub struct Filled {
 pub fn fill_holes(mesh: &Mesh, starts: &[(u32, u32)], fair: bool) -> Result<Filled> {
     let flat: Vec<u32> = starts.iter().flat_map(|&(a, b)| [a, b]).collect();
     let r = ffi::cgal_fill_holes(&mesh.positions, &mesh.indices, &flat, fair)
-        .map_err(|e| Error::backend("CGAL hole filling", e))?;
+        .backend("CGAL hole filling")?;
     Ok(Filled {
         positions: r.positions,
         indices: r.indices,

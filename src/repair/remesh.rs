@@ -4,7 +4,7 @@
 //! result is closed and manifold at that resolution, and features smaller than a voxel are lost.
 
 use crate::error::{Error, Result};
-use crate::ffi::vdb_remesh::ffi;
+use crate::grid::Grid;
 use crate::mesh::Mesh;
 
 /// Rebuilds `mesh` at `voxel` mm (adaptivity 0: uniform triangles). Returns the new mesh and the
@@ -25,16 +25,6 @@ pub fn remesh(mesh: &Mesh, voxel: f64) -> Result<(Mesh, u64)> {
             )));
         }
     }
-    let mut positions = Vec::new();
-    let mut indices = Vec::new();
-    let stats = ffi::vdb_remesh(
-        &mesh.positions,
-        &mesh.indices,
-        voxel,
-        0.0,
-        &mut positions,
-        &mut indices,
-    )
-    .map_err(|e| Error::backend("OpenVDB remeshing", e))?;
-    Ok((Mesh { positions, indices }, stats.active_voxels))
+    let grid = Grid::from_mesh(mesh, voxel, 3.0)?;
+    Ok((grid.to_mesh(0.0)?, grid.active_voxels()))
 }

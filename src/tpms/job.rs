@@ -217,12 +217,110 @@ impl TpmsJob {
         let start = Instant::now();
         self.validate()?;
         let (s, st) = (self.surface, self.structure);
-        let mut warnings = Vec::new();
         let range = calibrate::feasible(s, st);
+        let (conn, mut warnings) = self.connectivity(range)?;
         // The first call builds the unit cell's sample table: part of calibrating.
         let table_start = Instant::now();
         let t0 = calibrate::analytic_level(s, st, self.density);
         let table_seconds = table_start.elapsed().as_secs_f64();
+        let opts = Options {
+            adaptivity: self.adaptivity,
+            self_intersection: self.self_intersection,
+            instancing: self.instancing,
+            tile: self.tile,
+            memory: self.memory,
+            // Islands asked for are kept: the solid is meant to fall apart.
+            keep_fragments: self.keep_fragments || !conn.solid,
+        };
+        let search = self.search_resolution(t0, &opts, progress)?;
+        warnings.extend(search.raised);
+        let Found {
+            voxel,
+            cal,
+            family,
+            route,
+            solved,
+        } = search.found;
+        let Solved {
+            best,
+            tried,
+            meshing: search_meshing,
+            ..
+        } = solved;
+        let level = best.level;
+        let measured_on = match (&best.made, route) {
+            (pipeline::Made::Whole(_), _) => "part",
+            (_, Route::Tiled(_, None)) => "tiles",
+            _ => "template",
+        };
+        let written = pipeline::write(&family, best, voxel, route, &opts, progress, sink)?;
+        // The meshings of the search are part of the work (the whole route's last one is the
+        // part's own mesh).
+        let mut all_meshing = search_meshing;
+        if !matches!(route, Route::Whole(None)) {
+            all_meshing.add(&written.meshing);
+        }
+        let bounds = self.domain.bounds();
+        let measures = written.measures;
+        let achieved = measures.volume / bounds.volume();
+        let density_met = (achieved - self.density).abs() <= PROMISE;
+        let one_piece = match route {
+            Route::Tiled(_, None) => None,
+            _ => Some(written.fragments.count == 0 || written.fragments.removed),
+        };
+        warnings.extend(self.written_warnings(achieved, &written));
+        Ok(TpmsReport {
+            surface: s,
+            structure: st,
+            level,
+            target_density: self.density,
+            achieved_density: achieved,
+            density_error: achieved - self.density,
+            density_met,
+            calibration: cal,
+            level_search: LevelSearch {
+                measured_on,
+                tried: tried.iter().map(|&(t, f)| [t, f]).collect(),
+                coarser: search.coarser,
+            },
+            feasible_range: range,
+            connectivity: conn,
+            resolution_requested: self.resolution,
+            resolution: search.resolution,
+            voxel_size: voxel,
+            thinnest_wall_voxels: wall_voxels(s, st, t0, search.resolution),
+            cell_size: self.domain.cell,
+            cells: self.domain.counts(),
+            bounds,
+            triangles: measures.triangles,
+            vertices: written.vertices,
+            area: measures.area,
+            volume: Some(measures.volume),
+            bounding_box: (measures.triangles > 0).then_some(measures.bounds),
+            checks: written.checks,
+            fragments: written.fragments,
+            one_piece,
+            instancing: written.instancing,
+            tiling: written.tiling,
+            timings: Timings {
+                calibrate: table_seconds + search.calibrate_seconds,
+                sample: all_meshing.sample_seconds,
+                mesh: all_meshing.mesh_seconds,
+                snap: all_meshing.snap_seconds,
+                verify: written.verify_seconds,
+                write: written.write_seconds,
+                total: start.elapsed().as_secs_f64(),
+            },
+            meshing: all_meshing,
+            warnings,
+            output: None,
+        })
+    }
+
+    /// Whether the solid and the void are each one piece at this density; outside the feasible
+    /// range the job is refused unless islands are allowed. Warnings for what is allowed.
+    fn connectivity(&self, range: FeasibleRange) -> Result<(Connectivity, Vec<String>)> {
+        let (s, st) = (self.surface, self.structure);
         let voids = calibrate::void_connected_range(s, st);
         let conn = Connectivity {
             solid: self.density >= range.min && self.density <= range.max,
@@ -238,6 +336,7 @@ impl TpmsJob {
                 range.max
             )));
         }
+        let mut warnings = Vec::new();
         if !conn.solid {
             warnings.push("the solid falls apart into separate islands at this density".into());
         }
@@ -247,29 +346,25 @@ impl TpmsJob {
                     .into(),
             );
         }
+        Ok((conn, warnings))
+    }
 
-        let cell = self.domain.cell;
-        let opts = Options {
-            adaptivity: self.adaptivity,
-            self_intersection: self.self_intersection,
-            instancing: self.instancing,
-            tile: self.tile,
-            memory: self.memory,
-            // Islands asked for are kept: the solid is meant to fall apart.
-            keep_fragments: self.keep_fragments || !conn.solid,
-        };
-        // Sheet walls thinner than MIN_WALL_VOXELS perforate; a resolution that leaves them so
-        // is passed over without meshing.
-        let wall_at = |r: u32| {
-            (st == Structure::Sheet).then(|| calibrate::thinnest_sheet_wall(s, t0) * r as f64)
-        };
-        // The level is found on the part at the requested resolution; where the walls are too
-        // thin or no level reaches the target on these voxels, finer ones are searched (steps
-        // that double, then bisection), and the smallest that works is used (or, with a fixed
-        // resolution, named in the refusal).
+    /// The level is found on the part at the requested resolution; where sheet walls are too
+    /// thin or no level reaches the target on these voxels, finer ones are searched (steps that
+    /// double, then bisection), and the smallest that works is used (or, with a fixed
+    /// resolution, named in the refusal).
+    fn search_resolution(
+        &self,
+        t0: f64,
+        opts: &Options,
+        progress: &Progress,
+    ) -> Result<ResolutionSearch> {
+        let (s, st) = (self.surface, self.structure);
         let mut passed_over: Vec<String> = Vec::new();
         let mut start_at = self.resolution;
-        if let Some(w) = wall_at(start_at).filter(|&w| w < MIN_WALL_VOXELS) {
+        // Sheet walls thinner than MIN_WALL_VOXELS perforate; a resolution that leaves them so
+        // is passed over without meshing.
+        if let Some(w) = wall_voxels(s, st, t0, start_at).filter(|&w| w < MIN_WALL_VOXELS) {
             let needed = (start_at as f64 * MIN_WALL_VOXELS / w).ceil() as u32;
             passed_over.push(format!(
                 "sheet walls were {w:.2} voxels thin at {start_at} voxels per cell"
@@ -284,14 +379,14 @@ impl TpmsJob {
         }
         let limit = max_resolution(self.resolution).max(start_at);
         let mut coarser = Vec::new();
-        let mut calibrate_seconds = table_seconds;
+        let mut calibrate_seconds = 0.0;
         let mut attempt = |r: u32| -> Result<Option<Found>> {
             let _p = progress.stage(if r == self.resolution {
                 "calibrating and meshing"
             } else {
                 "searching for a resolution that reaches the density"
             });
-            let (cal_seconds, outcome) = self.attempt(r, &opts)?;
+            let (cal_seconds, outcome) = self.attempt(r, opts)?;
             calibrate_seconds += cal_seconds;
             Ok(match outcome {
                 Ok(found) => Some(found),
@@ -304,7 +399,9 @@ impl TpmsJob {
                 }
             })
         };
-        let Some(found) = pipeline::smallest_resolution(start_at, limit, &mut attempt)? else {
+        let Some((resolution, found)) =
+            pipeline::smallest_resolution(start_at, limit, &mut attempt)?
+        else {
             let closest = coarser.last().map_or(f64::NAN, |m| m.closest);
             return Err(Error::invalid(format!(
                 "no level gives the {} {} a density of {} within {PROMISE} at {} to {limit} voxels per cell (closest {closest:.4}); the box may cut the lattice into pieces",
@@ -321,16 +418,7 @@ impl TpmsJob {
                 miss.resolution, self.density, miss.closest
             ));
         }
-        let (
-            resolution,
-            Found {
-                voxel,
-                cal,
-                family,
-                route,
-                solved,
-            },
-        ) = found;
+        let mut raised = Vec::new();
         if let Some(why) = passed_over.first() {
             if !self.auto_resolution {
                 return Err(Error::invalid(format!(
@@ -340,61 +428,37 @@ impl TpmsJob {
                     self.density
                 )));
             }
-            warnings.push(format!(
+            raised.push(format!(
                 "resolution raised from {} to {resolution} voxels per cell: {why}",
                 self.resolution
             ));
         }
-        let wall = wall_at(resolution);
-        let bounds = self.domain.bounds();
-        let Solved {
-            best,
-            tried,
-            meshing: search_meshing,
-            ..
-        } = solved;
-        let level = best.level;
-        let measured_on = match (&best.made, route) {
-            (pipeline::Made::Whole(_), _) => "part",
-            (_, Route::Tiled(_, None)) => "tiles",
-            _ => "template",
-        };
-        let pipeline::Written {
-            checks,
-            meshing,
-            measures,
-            vertices,
-            fragments,
-            instancing,
-            tiling,
-            verify_seconds,
-            write_seconds,
-        } = pipeline::write(&family, best, voxel, route, &opts, progress, sink)?;
-        // The meshings of the search are part of the work (the whole route's last one is the
-        // part's own mesh).
-        let mut all_meshing = search_meshing;
-        if !matches!(route, Route::Whole(None)) {
-            all_meshing.add(&meshing);
-        }
-        let volume = measures.volume;
-        let achieved = volume / bounds.volume();
-        let density_met = (achieved - self.density).abs() <= PROMISE;
-        if !density_met {
+        Ok(ResolutionSearch {
+            resolution,
+            found,
+            coarser,
+            calibrate_seconds,
+            raised,
+        })
+    }
+
+    /// What the written mesh says that the user should hear: a missed density (a bug), a
+    /// failed CGAL check, fragments cut loose by the box.
+    fn written_warnings(&self, achieved: f64, written: &pipeline::Written) -> Vec<String> {
+        let mut warnings = Vec::new();
+        if (achieved - self.density).abs() > PROMISE {
             warnings.push(format!(
                 "the written mesh's density {achieved:.4} misses the target {} by more than {PROMISE}: please report this",
                 self.density
             ));
         }
-        if !checks.verdict().is_valid_solid() {
+        if !written.checks.verdict().is_valid_solid() {
             warnings.push(
                 "CGAL did not find the mesh a valid closed, outward, self-intersection-free solid"
                     .into(),
             );
         }
-        let one_piece = match route {
-            Route::Tiled(_, None) => None,
-            _ => Some(fragments.count == 0 || fragments.removed),
-        };
+        let fragments = &written.fragments;
         if fragments.count > 0 {
             warnings.push(format!(
                 "{} fragment{} cut loose by the box ({:.3} mm³) {}",
@@ -408,52 +472,7 @@ impl TpmsJob {
                 }
             ));
         }
-        Ok(TpmsReport {
-            surface: s,
-            structure: st,
-            level,
-            target_density: self.density,
-            achieved_density: achieved,
-            density_error: achieved - self.density,
-            density_met,
-            calibration: cal,
-            level_search: LevelSearch {
-                measured_on,
-                tried: tried.iter().map(|&(t, f)| [t, f]).collect(),
-                coarser,
-            },
-            feasible_range: range,
-            connectivity: conn,
-            resolution_requested: self.resolution,
-            resolution,
-            voxel_size: voxel,
-            thinnest_wall_voxels: wall,
-            cell_size: cell,
-            cells: self.domain.counts(),
-            bounds,
-            triangles: measures.triangles,
-            vertices,
-            area: measures.area,
-            volume: Some(volume),
-            bounding_box: (measures.triangles > 0).then_some(measures.bounds),
-            checks,
-            fragments,
-            one_piece,
-            instancing,
-            tiling,
-            timings: Timings {
-                calibrate: calibrate_seconds,
-                sample: all_meshing.sample_seconds,
-                mesh: all_meshing.mesh_seconds,
-                snap: all_meshing.snap_seconds,
-                verify: verify_seconds,
-                write: write_seconds,
-                total: start.elapsed().as_secs_f64(),
-            },
-            meshing: all_meshing,
-            warnings,
-            output: None,
-        })
+        warnings
     }
 
     /// Calibrates a first level at `resolution` and searches the level for the part from it:
@@ -516,6 +535,22 @@ struct Found {
     family: LatticeFamily,
     route: Route,
     solved: Solved,
+}
+
+/// The outcome of the resolution search: the resolution used and the part found there, the
+/// coarser resolutions that missed, the seconds spent calibrating, and the warning when the
+/// resolution was raised.
+struct ResolutionSearch {
+    resolution: u32,
+    found: Found,
+    coarser: Vec<ResolutionMiss>,
+    calibrate_seconds: f64,
+    raised: Vec<String>,
+}
+
+/// Sheet walls' thinnest width in voxels at `resolution` (nets: none).
+fn wall_voxels(s: Surface, st: Structure, t0: f64, resolution: u32) -> Option<f64> {
+    (st == Structure::Sheet).then(|| calibrate::thinnest_sheet_wall(s, t0) * resolution as f64)
 }
 
 /// The finest resolution tried before a part is refused.

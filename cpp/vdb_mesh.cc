@@ -1,13 +1,9 @@
-// Builds an OpenVDB FloatGrid level set from 8^3 leaf blocks sampled in Rust and meshes it.
-//
-// Leaves are constructed in parallel (TBB), attached serially, then signedFloodFill gives the
-// culled interior its negative sign so volumeToMesh sees one closed surface.
-#include "vdb.h"
-
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/SignedFloodFill.h>
+// Meshing a level set with OpenVDB's volumeToMesh, two ways:
+//  - vdb_volume_to_mesh: any iso-surface at any adaptivity, as outward-wound triangles (every
+//    path that wants a plain mesh: sampled parts, smoothed fields, remeshed parts);
+//  - vdb_extract: the zero iso-surface in index space at adaptivity 0, with each point's voxel
+//    and edge group recovered, for meshing a part in pieces that weld exactly.
 #include <openvdb/tools/VolumeToMesh.h>
-#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
 #include <array>
@@ -16,85 +12,19 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "latvox/src/ffi/vdb.rs.h"
+#include "vdb_internal.h"
 
 namespace latvox {
 
-struct VdbGrid::Impl {
-  openvdb::FloatGrid::Ptr grid;
-};
-VdbGrid::VdbGrid() : impl(std::make_unique<Impl>()) {}
-VdbGrid::~VdbGrid() = default;
-
-namespace {
-std::once_flag init_flag;
-void ensure_init() {
-  std::call_once(init_flag, [] { openvdb::initialize(); });
-}
-std::unique_ptr<tbb::global_control> thread_control;
-}  // namespace
-
-void vdb_set_threads(std::size_t threads) {
-  if (threads == 0) {
-    thread_control.reset();
-  } else {
-    thread_control = std::make_unique<tbb::global_control>(
-        tbb::global_control::max_allowed_parallelism, threads);
-  }
-}
-
-std::unique_ptr<VdbGrid> vdb_grid_from_leaves(double voxel_size, rust::Slice<const double> origin,
-                                              float half_width,
-                                              rust::Slice<const int32_t> leaf_origins,
-                                              rust::Slice<const float> values) {
-  using LeafT = openvdb::FloatTree::LeafNodeType;
-  ensure_init();
-  if (!(voxel_size > 0.0) || !std::isfinite(voxel_size))
-    throw std::invalid_argument("voxel size must be positive and finite");
-  if (origin.size() != 3) throw std::invalid_argument("origin needs three coordinates");
-  const std::size_t n = leaf_origins.size() / 3;
-  if (leaf_origins.size() != 3 * n || values.size() != n * LeafT::SIZE)
-    throw std::invalid_argument("leaf data does not hold 512 values per leaf origin");
-
-  const float background = half_width * static_cast<float>(voxel_size);
-  auto grid = openvdb::FloatGrid::create(background);
-  grid->setGridClass(openvdb::GRID_LEVEL_SET);
-  grid->setName("latvox");
-  // Voxel (i,j,k) holds the sample taken at origin + (i + 1/2) h: box faces fall between samples.
-  auto xform = openvdb::math::Transform::createLinearTransform(voxel_size);
-  xform->postTranslate(openvdb::Vec3d(origin[0] + 0.5 * voxel_size, origin[1] + 0.5 * voxel_size,
-                                      origin[2] + 0.5 * voxel_size));
-  grid->setTransform(xform);
-
-  std::vector<LeafT*> leaves(n, nullptr);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      openvdb::Coord c(leaf_origins[3 * i], leaf_origins[3 * i + 1], leaf_origins[3 * i + 2]);
-      auto* leaf = new LeafT(c, background, false);
-      const float* v = values.data() + i * LeafT::SIZE;
-      for (openvdb::Index k = 0; k < LeafT::SIZE; ++k) {
-        const float x = v[k];
-        leaf->setValueOnly(k, x);
-        if (std::fabs(x) < background) leaf->setValueOn(k);
-      }
-      leaves[i] = leaf;
-    }
-  });
-  auto& tree = grid->tree();
-  for (auto* leaf : leaves) tree.addLeaf(leaf);
-  openvdb::tools::signedFloodFill(tree);
-  auto out = std::make_unique<VdbGrid>();
-  out->impl->grid = grid;
-  return out;
-}
-
-void vdb_volume_to_mesh(const VdbGrid& g, double adaptivity, rust::Vec<float>& positions,
-                        rust::Vec<uint32_t>& indices) {
+void vdb_volume_to_mesh(const VdbGrid& g, double isovalue, double adaptivity,
+                        rust::Vec<float>& positions, rust::Vec<uint32_t>& indices) {
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> tris;
   std::vector<openvdb::Vec4I> quads;
-  openvdb::tools::volumeToMesh(*g.impl->grid, points, tris, quads, 0.0, adaptivity, true);
+  openvdb::tools::volumeToMesh(*g.impl->grid, points, tris, quads, isovalue, adaptivity, true);
   if (points.size() >= static_cast<std::size_t>(UINT32_MAX))
     throw std::length_error("mesh has more vertices than 32-bit indices can address");
 
@@ -211,17 +141,6 @@ void vdb_extract(const VdbGrid& g, Extraction& out) {
   for (std::size_t n = 0; n < mesher.polygonPoolListSize(); ++n)
     for (std::size_t q = 0; q < pools[n].numQuads(); ++q)
       for (int k = 0; k < 4; ++k) out.quads.push_back(pools[n].quad(q)[k]);
-}
-
-uint64_t vdb_active_voxels(const VdbGrid& g) { return g.impl->grid->activeVoxelCount(); }
-uint64_t vdb_leaf_count(const VdbGrid& g) { return g.impl->grid->tree().leafCount(); }
-uint64_t vdb_memory_bytes(const VdbGrid& g) { return g.impl->grid->memUsage(); }
-
-void vdb_write(const VdbGrid& g, rust::Str path) {
-  openvdb::io::File file{std::string(path)};
-  openvdb::GridPtrVec grids{g.impl->grid};
-  file.write(grids);
-  file.close();
 }
 
 }  // namespace latvox

@@ -15,7 +15,6 @@
 
 #include <array>
 #include <cmath>
-#include <iterator>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -103,23 +102,6 @@ CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint
       self_intersection && (parallel ? PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh)
                                      : PMP::does_self_intersect<CGAL::Sequential_tag>(mesh));
   return r;
-}
-
-rust::Vec<uint32_t> cgal_self_intersections(rust::Slice<const float> positions,
-                                            rust::Slice<const uint32_t> indices,
-                                            std::size_t limit) {
-  Mesh mesh;
-  if (!build_mesh(positions, indices, mesh))
-    throw std::invalid_argument("face indices need an oriented 2-manifold mesh");
-  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
-  PMP::self_intersections<CGAL::Parallel_if_available_tag>(faces(mesh), mesh,
-                                                           std::back_inserter(pairs));
-  rust::Vec<uint32_t> out;
-  for (std::size_t i = 0; i < pairs.size() && i < limit; ++i) {
-    out.push_back(static_cast<uint32_t>(pairs[i].first));
-    out.push_back(static_cast<uint32_t>(pairs[i].second));
-  }
-  return out;
 }
 
 }  // namespace latvox
