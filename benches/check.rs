@@ -217,11 +217,12 @@ fn main() {
     let mesh = &loaded.mesh;
     let all: Vec<u32> = (0..mesh.triangle_count() as u32).collect();
     let (t_whole, whole) = time(runs, || {
-        latvox::repair::cgal::soup_self_intersections_in_tiles(mesh, &all, None, 16, 0).unwrap()
+        latvox::check::self_intersect::soup_self_intersections_in_tiles(mesh, &all, None, 16, 0)
+            .unwrap()
     });
     let c_whole = cpu();
     let (t_tiled, tiled) = time(runs, || {
-        latvox::repair::cgal::soup_self_intersections(mesh, &all, None, 16).unwrap()
+        latvox::check::self_intersect::soup_self_intersections(mesh, &all, None, 16).unwrap()
     });
     let c_tiled = cpu();
     assert_eq!(whole, tiled);

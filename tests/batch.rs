@@ -5,6 +5,7 @@
 //! failures reported and retried.
 
 mod common;
+mod meshkit;
 use common::*;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -212,33 +213,11 @@ fn write_plate_field(path: &Path) -> Vec<f64> {
     field
 }
 
-/// A 10 mm cube, outward, with one facet left out (a hole), as ASCII STL.
+/// A 10 mm cube, outward, with one facet left out (a hole).
 fn write_open_cube(path: &Path) {
-    let p = |i: usize| [i & 1, (i >> 1) & 1, (i >> 2) & 1].map(|b| 10.0 * b as f64);
-    let faces = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let mut text = String::from("solid open\n");
-    for (k, q) in faces.iter().enumerate() {
-        for (n, t) in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]].iter().enumerate() {
-            if k == 0 && n == 1 {
-                continue;
-            }
-            text.push_str("facet normal 0 0 0\nouter loop\n");
-            for &v in t {
-                let [x, y, z] = p(v);
-                text.push_str(&format!("vertex {x} {y} {z}\n"));
-            }
-            text.push_str("endloop\nendfacet\n");
-        }
-    }
-    text.push_str("endsolid open\n");
-    std::fs::write(path, text).unwrap();
+    let mut facets = meshkit::cuboid([0.0; 3], [10.0; 3]);
+    facets.remove(1);
+    meshkit::write_stl(path, &facets);
 }
 
 #[test]

@@ -598,7 +598,7 @@ fn torus(nu: usize, nv: usize, offset: P) -> Vec<Tri> {
 /// brute-forced.
 #[test]
 fn tiled_self_intersection_search_finds_the_pairs_of_the_whole_search() {
-    use latvox::repair::cgal::soup_self_intersections_in_tiles;
+    use latvox::check::self_intersect::soup_self_intersections_in_tiles;
     let data = cgal_data();
     let dir = tempdir();
     let mut tori = torus(40, 20, [0.0; 3]);
@@ -627,7 +627,7 @@ fn tiled_self_intersection_search_finds_the_pairs_of_the_whole_search() {
             .iter()
             .flat_map(|&f| mesh.indices[3 * f as usize..3 * f as usize + 3].to_vec())
             .collect();
-        let (faces, starts) = latvox::repair::cgal::box_tiles(&mesh.positions, &soup, 1);
+        let (faces, starts) = latvox::check::self_intersect::box_tiles(&mesh.positions, &soup, 1);
         if keep.len() > 100 {
             assert_eq!(starts.len(), 3, "{}", file.display());
             assert!(faces.len() < keep.len() * 3 / 2);

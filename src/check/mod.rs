@@ -13,6 +13,7 @@
 
 pub mod cgal;
 mod file;
+pub mod self_intersect;
 pub(crate) mod verdict;
 
 pub use file::{check_file, read_file, Defects, FileCheckReport};
@@ -828,7 +829,7 @@ fn self_intersections(
     let keep: Vec<u32> = (0..nf as u32)
         .filter(|&f| topo.active[f as usize] && !zero[f as usize] && !is_dup[f as usize])
         .collect();
-    crate::repair::cgal::soup_self_intersections(mesh, &keep, Some(flip), 16)
+    crate::check::self_intersect::soup_self_intersections(mesh, &keep, Some(flip), 16)
 }
 
 /// The shell of the facet that owns boundary half-edge a→b.

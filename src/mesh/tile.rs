@@ -189,7 +189,7 @@ fn tile_result(mesh: &KeyedMesh, own: &IndexBox, self_intersection: bool) -> Res
         }
         let all: Vec<u32> = (0..patch.triangle_count() as u32).collect();
         let (_, pairs) =
-            crate::repair::cgal::soup_self_intersections(&patch, &all, None, usize::MAX)?;
+            crate::check::self_intersect::soup_self_intersections(&patch, &all, None, usize::MAX)?;
         pairs.iter().any(|&(f, g)| f.min(g) < kept_triangles)
     } else {
         false
