@@ -198,7 +198,7 @@ fn main() {
             "-t n -d 0.477 --size 7.96,6.3,9.17 --cell-size 5.01",
             "-t g -d 0.3 --size 23.7,17.3,9.1 --cell-size 5",
             "-t g -d 0.3 --cells 2 --cell-size 5 --resolution 12",
-            "-t g -d 0.3 --cells 10 --cell-size 5",
+            "-t g -d 0.3 --cells 4 --cell-size 5",
         ] {
             let mut args = vec!["tpms", "--quiet"];
             args.extend(case.split(' '));
@@ -206,7 +206,7 @@ fn main() {
             let (wall, _, rep) = measure(exe, &args, &out, runs);
             let search = &rep["level_search"];
             println!(
-                "  {case}: {} meshings on the {}, density {:.4}, wall {wall:.2} s (median)",
+                "  {case}: {} meshing(s) on the {}, density {:.4}, wall {wall:.2} s (median)",
                 search["tried"].as_array().map_or(0, |t| t.len()),
                 search["measured_on"].as_str().unwrap_or("?"),
                 rep["achieved_density"].as_f64().unwrap_or(f64::NAN),

@@ -170,6 +170,12 @@ impl KeyedMesh {
             .sum()
     }
 
+    /// The mesh in single precision, as it is written; the keyed mesh (keys, offsets, quads:
+    /// as large again as the mesh) is freed before the caller goes on.
+    pub fn into_mesh(self) -> Mesh {
+        self.to_mesh()
+    }
+
     /// The mesh in single precision, as it is written.
     pub fn to_mesh(&self) -> Mesh {
         Mesh {

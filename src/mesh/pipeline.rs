@@ -575,7 +575,7 @@ pub fn write<F: Family>(
             write_instanced(t, plan, m.meshing, m.fragments, o, progress, sink)
         }
         (Route::Whole(_), Made::Whole(mesh)) => {
-            write_whole(mesh.to_mesh(), m.meshing, m.fragments, o, progress, sink)
+            write_whole(mesh.into_mesh(), m.meshing, m.fragments, o, progress, sink)
         }
         (Route::Whole(_), Made::Tiles(_)) => {
             // Found on a measuring template: mesh the part at the level found.
@@ -588,7 +588,7 @@ pub fn write<F: Family>(
             } else {
                 pieces::remove_fragments(&mut mesh)
             };
-            write_whole(mesh.to_mesh(), meshing, fragments, o, progress, sink)
+            write_whole(mesh.into_mesh(), meshing, fragments, o, progress, sink)
         }
         (Route::Tiled(edge, _), Made::Tiles(template)) => write_tiled(
             &solid,

@@ -59,7 +59,7 @@ impl Lattice {
     pub fn mesh(&self, voxel: f64, adaptivity: f64) -> Result<(Mesh, MeshingStats)> {
         let spec = GridSpec::covering(&self.bounds, voxel, HALF_WIDTH);
         let (keyed, stats) = mesh_keyed(self, spec, None, adaptivity, None)?;
-        Ok((keyed.to_mesh(), stats))
+        Ok((keyed.into_mesh(), stats))
     }
 
     /// Volume of the solid inside `b`, a box within the bounds: only the vertices of triangles
