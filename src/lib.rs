@@ -65,6 +65,7 @@ pub mod io;
 pub mod mesh;
 pub mod progress;
 pub mod repair;
+pub mod strut;
 pub mod topopt;
 pub mod tpms;
 

@@ -14,7 +14,6 @@
 
 mod common;
 use common::*;
-use std::collections::HashMap;
 use std::path::Path;
 
 /// splitmix64: a small, well-mixed generator, enough to draw cases reproducibly.
@@ -172,42 +171,6 @@ fn run_case(c: &Case, resolution: u32, fixed: bool, dir: &Path) -> Run {
         stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
         report: rep.exists().then(|| json(&rep)),
     }
-}
-
-/// Shells with positive volume (outer surfaces of separate pieces), found by joining triangles
-/// that share a corner.
-fn pieces(tris: &[Tri]) -> usize {
-    let key = |p: [f64; 3]| p.map(|x| (x as f32).to_bits());
-    let mut id: HashMap<[u32; 3], usize> = HashMap::new();
-    let corners: Vec<[usize; 3]> = tris
-        .iter()
-        .map(|t| {
-            t.map(|p| {
-                let n = id.len();
-                *id.entry(key(p)).or_insert(n)
-            })
-        })
-        .collect();
-    let mut parent: Vec<usize> = (0..id.len()).collect();
-    fn find(p: &mut [usize], mut x: usize) -> usize {
-        while p[x] != x {
-            p[x] = p[p[x]];
-            x = p[x];
-        }
-        x
-    }
-    for c in &corners {
-        for k in 1..3 {
-            let (a, b) = (find(&mut parent, c[0]), find(&mut parent, c[k]));
-            parent[a.max(b)] = a.min(b);
-        }
-    }
-    let mut shell_volume: HashMap<usize, f64> = HashMap::new();
-    for (t, c) in tris.iter().zip(&corners) {
-        let r = find(&mut parent, c[0]);
-        *shell_volume.entry(r).or_default() += volume(std::slice::from_ref(t));
-    }
-    shell_volume.values().filter(|&&v| v > 0.0).count()
 }
 
 /// Checks a successful run's file; returns a description of what is wrong, if anything.

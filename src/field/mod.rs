@@ -6,6 +6,8 @@
 //! clearance never overestimates, a skipped block can never hide a piece of surface (a skipped
 //! block that the surface crossed would be a hole in the mesh).
 
+pub mod periodic;
+
 /// A point or vector in millimetres.
 pub type Vec3 = [f64; 3];
 

@@ -9,7 +9,7 @@
 //! the first-order distance `(F − t)/|∇F|` (resp. `(|F| − t)/|∇F|`), and the culling clearance is
 //! `|F − t| / L` with `L ≥ max |∇F|`, which never overestimates the distance to the surface.
 
-use crate::field::{Field, Vec3};
+use crate::field::{periodic, Field, Vec3};
 use std::f64::consts::TAU;
 
 /// Which surface.
@@ -365,16 +365,7 @@ impl TpmsField {
     /// Turns on index-periodic block sampling along each axis where a cell spans a whole number
     /// of voxels `h`.
     pub fn with_periodic_samples(mut self, h: f64) -> Self {
-        let p = [0, 1, 2].map(|a| {
-            let n = (self.cell[a] / h).round();
-            let whole = n >= 1.0 && (self.cell[a] / h - n).abs() < 1e-9 * n;
-            if whole {
-                n as u32
-            } else {
-                0
-            }
-        });
-        self.samples_per_cell = (p != [0; 3]).then_some((p, h));
+        self.samples_per_cell = periodic::samples_per_cell(self.cell, h);
         self
     }
 
@@ -443,18 +434,15 @@ impl Field for TpmsField {
     fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
         let mut tabs = [[AxisTable::default(); 8]; 3];
         for (a, tab) in tabs.iter_mut().enumerate() {
-            // Index of the block's first sample from the phase origin, if samples sit at
-            // phase + (j + ½)·h and a cell holds a whole number of them.
-            let periodic = self.samples_per_cell.and_then(|(p, hp)| {
-                let j = (origin[a] - self.origin[a]) / h - 0.5;
-                let r = j.round();
-                (hp == h && p[a] > 0 && (j - r).abs() < 1e-6).then_some((r as i64, p[a] as i64))
-            });
-            for (i, t) in tab.iter_mut().enumerate() {
-                let u = match periodic {
-                    Some((j0, p)) => ((j0 + i as i64).rem_euclid(p) as f64 + 0.5) / p as f64,
-                    None => (origin[a] + h * i as f64 - self.origin[a]) / self.cell[a],
-                };
+            let u = periodic::block_axis(
+                self.samples_per_cell,
+                self.origin[a],
+                self.cell[a],
+                origin[a],
+                h,
+                a,
+            );
+            for (t, u) in tab.iter_mut().zip(u) {
                 *t = AxisTable::at_turns(u);
             }
         }

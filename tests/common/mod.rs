@@ -102,6 +102,42 @@ pub fn volume(tris: &[Tri]) -> f64 {
         .sum()
 }
 
+/// Shells with positive volume (outer surfaces of separate pieces), found by joining triangles
+/// that share a corner.
+pub fn pieces(tris: &[Tri]) -> usize {
+    let key = |p: [f64; 3]| p.map(|x| (x as f32).to_bits());
+    let mut id: HashMap<[u32; 3], usize> = HashMap::new();
+    let corners: Vec<[usize; 3]> = tris
+        .iter()
+        .map(|t| {
+            t.map(|p| {
+                let n = id.len();
+                *id.entry(key(p)).or_insert(n)
+            })
+        })
+        .collect();
+    let mut parent: Vec<usize> = (0..id.len()).collect();
+    fn find(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    for c in &corners {
+        for k in 1..3 {
+            let (a, b) = (find(&mut parent, c[0]), find(&mut parent, c[k]));
+            parent[a.max(b)] = a.min(b);
+        }
+    }
+    let mut shell_volume: HashMap<usize, f64> = HashMap::new();
+    for (t, c) in tris.iter().zip(&corners) {
+        let r = find(&mut parent, c[0]);
+        *shell_volume.entry(r).or_default() += volume(std::slice::from_ref(t));
+    }
+    shell_volume.values().filter(|&&v| v > 0.0).count()
+}
+
 pub fn bounds(tris: &[Tri]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
