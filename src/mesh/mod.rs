@@ -1,6 +1,6 @@
 //! Meshes: the triangle mesh and what makes one from a grid and gets it out.
 //!
-//! [`indexed`] is the mesh type and its measures; [`extract`] meshes a level set with every
+//! `indexed` is the mesh type and its measures; [`extract`] meshes a level set with every
 //! vertex named by its voxel and edge group, [`snap`] moves the vertices onto the exact surface,
 //! [`tile`] and [`instance`] mesh large parts in pieces that weld exactly, [`pieces`] finds the
 //! fragments a box cuts loose, and [`pipeline`] puts them together: any clipped field to a
