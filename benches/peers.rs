@@ -222,11 +222,11 @@ fn child(a: &[String]) {
                 .run_into(&latvox::progress::Progress::hidden(), &mut sink)
                 .unwrap();
             sink.commit().unwrap();
-            out.insert("triangles".into(), json!(report.triangles));
+            out.insert("triangles".into(), json!(report.part.triangles));
             out.insert("level".into(), json!(report.level));
-            out.insert("stages".into(), json!(report.timings));
-            out.insert("job_checks".into(), json!(report.checks));
-            out.insert("instanced".into(), json!(report.instancing));
+            out.insert("stages".into(), json!(report.part.timings));
+            out.insert("job_checks".into(), json!(report.part.checks));
+            out.insert("instanced".into(), json!(report.part.instancing));
             None
         }
         "latvox mesh" => {

@@ -1,16 +1,15 @@
-//! Strut lattices through the library's pipeline (the `latvox strut` command is still to come):
-//! each built-in cell in 10×10×10 cells of 5 mm at density 0.2, 32 voxels per cell, its radius
+//! Strut lattices made by the library's strut job (what `latvox strut` runs): each built-in cell in 10×10×10 cells of 5 mm at density 0.2, 32 voxels per cell, its radius
 //! found on a template of its cells, the part copied from the template into a binary STL, with
 //! CGAL's checks (self-intersection included). Printed: wall time in this process, meshings of
 //! the search, achieved density, triangles, and the process's peak resident memory so far.
 //!
 //! Run: `cargo bench --bench strut` (add `-- CELL` to run one cell).
 
-use latvox::field::Aabb;
+use latvox::field::Domain;
 use latvox::io::sink::MeshFile;
-use latvox::mesh::pipeline::{self, Family, Options, Route};
+use latvox::mesh::pipeline::Options;
 use latvox::progress::Progress;
-use latvox::strut::{StrutFamily, StrutLattice, UnitCell};
+use latvox::strut::{Sizing, StrutJob, UnitCell};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -29,55 +28,46 @@ fn peak_rss_mb() -> f64 {
 fn main() {
     let only: Option<String> = std::env::args().skip(1).find(|a| !a.starts_with('-'));
     let dir = tempfile::tempdir().unwrap();
-    let (cells, cell_size, resolution, target) = (10.0, 5.0, 32.0, 0.2);
-    let voxel = cell_size / resolution;
-    let bounds = Aabb {
-        min: [0.0; 3],
-        max: [cells * cell_size; 3],
-    };
-    let opts = Options {
-        self_intersection: true,
-        instancing: true,
-        ..Default::default()
-    };
+    let domain = Domain::from_cells([10; 3], [5.0; 3], [0.0; 3]).unwrap();
     println!("10x10x10 cells of 5 mm, density 0.2, 32 voxels per cell, STL with CGAL's checks:");
     for name in latvox::strut::cell::BUILT_IN {
         if only.as_deref().is_some_and(|o| o != name) {
             continue;
         }
         let t = Instant::now();
-        let family = StrutFamily::new(StrutLattice {
+        let job = StrutJob {
             cell: Arc::new(UnitCell::built_in(name).unwrap()),
-            size: [cell_size; 3],
-            radius: 0.0,
+            cell_name: name.to_string(),
+            sizing: Sizing::Density(0.2),
             blend: 0.0,
-            bounds,
-            phase: bounds.min,
-        });
-        let start = family.model_level(target);
-        let route = Route::choose(&family.at(start), voxel, &opts);
-        let solved = pipeline::solve(&family, target, start, voxel, route, &opts).unwrap();
-        let (radius, meshings) = (solved.best.level, solved.tried.len());
+            domain,
+            resolution: 32,
+            auto_resolution: true,
+            options: Options {
+                self_intersection: true,
+                instancing: true,
+                ..Default::default()
+            },
+        };
         let out = dir.path().join("s.stl");
-        let file = MeshFile::new(&out, false).unwrap();
-        let mut sink = file.sink().unwrap();
-        let written = pipeline::write(
-            &family,
-            solved.best,
-            voxel,
-            route,
-            &opts,
-            &Progress::hidden(),
-            &mut sink,
-        )
-        .unwrap();
+        let mut sink = MeshFile::new(&out, false).unwrap().sink().unwrap();
+        let r = job.run_into(&Progress::hidden(), &mut sink).unwrap();
         sink.commit().unwrap();
         let wall = t.elapsed().as_secs_f64();
+        let p = &r.part;
         println!(
-            "  {name:8} radius {radius:.4} mm, {meshings} meshing(s), density {:.4}, {} triangles, valid {}: wall {wall:.2} s, peak RSS so far {:.0} MB",
-            written.measures.volume / (cells * cell_size).powi(3),
-            written.measures.triangles,
-            written.checks.verdict().is_valid_solid(),
+            "  {name:8} radius {:.4} mm, {} meshing(s), density {:.4}, {} triangles, valid {}: wall {wall:.2} s (model {:.2}, sample {:.2}, mesh {:.2}, snap {:.2}, verify {:.2}, write {:.2}), peak RSS so far {:.0} MB",
+            r.radius,
+            r.level_search.tried.len(),
+            p.achieved_density,
+            p.triangles,
+            r.verdict().is_valid_solid(),
+            p.timings.calibrate,
+            p.timings.sample,
+            p.timings.mesh,
+            p.timings.snap,
+            p.timings.verify,
+            p.timings.write,
             peak_rss_mb()
         );
     }

@@ -18,7 +18,7 @@ Exit codes (every command):
 #[command(
     name = "latvox",
     version,
-    about = "Sparse-volume voxel engine for additive manufacturing: TPMS lattices at exact density, verified by CGAL",
+    about = "Sparse-volume voxel engine for additive manufacturing: TPMS and strut lattices at exact density, verified by CGAL",
     long_about = None,
     after_help = EXIT_CODES
 )]
@@ -38,6 +38,10 @@ enum Command {
     /// Generate a closed TPMS lattice at an exact volume fraction.
     #[command(after_help = cli::tpms::EXAMPLES)]
     Tpms(cli::tpms::TpmsArgs),
+    /// Generate a closed strut (beam) lattice — BCC, octet, Kelvin or a cell of your own — at an
+    /// exact volume fraction or strut radius.
+    #[command(after_help = cli::strut::EXAMPLES)]
+    Strut(cli::strut::StrutArgs),
     /// Check a mesh file: every defect counted (holes, non-manifold, winding, normals, degenerate
     /// and duplicate facets, T-junctions, self-intersections), per shell too.
     #[command(after_help = cli::check::EXAMPLES)]
@@ -97,6 +101,7 @@ fn main() {
     }
     let result = match &cli.command {
         Command::Tpms(a) => cli::tpms::run(a, cli.quiet),
+        Command::Strut(a) => cli::strut::run(a, cli.quiet),
         Command::Check(a) => cli::check::run(a, cli.quiet),
         Command::Repair(a) => cli::repair::run(a, cli.quiet),
         Command::Topopt(a) => cli::topopt::run(a, cli.quiet),

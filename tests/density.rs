@@ -26,10 +26,10 @@ fn every_type_and_structure_hits_its_target_within_0_002() {
                 };
                 let (mesh, r) = job.run(&latvox::progress::Progress::hidden()).unwrap();
                 assert!(
-                    r.checks.closed && r.checks.outward && r.checks.manifold,
+                    r.part.checks.closed && r.part.checks.outward && r.part.checks.manifold,
                     "{surface:?} {structure:?} {target}"
                 );
-                let vf = r.achieved_density;
+                let vf = r.part.achieved_density;
                 eprintln!(
                     "{:8} {:6} {target:.2}: {vf:.5} ({:+.5}), resolution {}, {} triangles",
                     surface.name(),

@@ -1,17 +1,17 @@
-//! Strut lattices through the meshing pipeline, as a library user drives it: every built-in cell
-//! at densities 0.1, 0.2 and 0.3 in a block of 3×3×3 cells at 32 voxels per cell, its radius
-//! found for the density on the part, written, and measured here with the tests' own code
-//! (volume by the divergence theorem, edges by hash map, pieces by shared corners); CGAL's
-//! checks from the pipeline.
+//! Strut lattices as a library user makes them: every built-in cell at densities 0.1, 0.2 and
+//! 0.3 in a block of 3×3×3 cells at 32 voxels per cell (the resolution fixed, so a cell that
+//! needed more would fail here), its radius found for the density on the part by the strut
+//! job, written, and measured here with the tests' own code (volume by the divergence theorem,
+//! edges by hash map, pieces by shared corners); CGAL's checks from the job's report.
 
 mod common;
 
 use common::*;
-use latvox::field::Aabb;
+use latvox::field::{Aabb, Domain};
 use latvox::io::sink::MeshCollector;
-use latvox::mesh::pipeline::{self, Family, Options, Route};
+use latvox::mesh::pipeline::Options;
 use latvox::progress::Progress;
-use latvox::strut::{StrutFamily, StrutLattice, UnitCell};
+use latvox::strut::{Sizing, StrutJob, StrutLattice, UnitCell};
 use std::sync::Arc;
 
 /// The part's triangles, as the tests' own type.
@@ -31,42 +31,27 @@ fn triangles(c: &MeshCollector) -> Vec<Tri> {
 fn every_built_in_cell_meets_its_density_closed_and_in_one_piece() {
     let cell_size = 5.0;
     let voxel = cell_size / 32.0;
-    let bounds = Aabb {
-        min: [1.5, -2.0, 0.25],
-        max: [16.5, 13.0, 15.25],
-    };
-    let opts = Options {
-        self_intersection: true,
-        instancing: true,
-        ..Default::default()
-    };
+    let domain = Domain::from_cells([3; 3], [cell_size; 3], [1.5, -2.0, 0.25]).unwrap();
+    let bounds = domain.bounds();
     let mut failures = Vec::new();
     for name in latvox::strut::cell::BUILT_IN {
-        let family = StrutFamily::new(StrutLattice {
-            cell: Arc::new(UnitCell::built_in(name).unwrap()),
-            size: [cell_size; 3],
-            radius: 0.0,
-            blend: 0.0,
-            bounds,
-            phase: bounds.min,
-        });
         for target in [0.1, 0.2, 0.3] {
-            let start = family.model_level(target);
-            let part = family.at(start);
-            let route = Route::choose(&part, voxel, &opts);
-            let solved = pipeline::solve(&family, target, start, voxel, route, &opts).unwrap();
-            let radius = solved.best.level;
+            let job = StrutJob {
+                cell: Arc::new(UnitCell::built_in(name).unwrap()),
+                cell_name: name.to_string(),
+                sizing: Sizing::Density(target),
+                blend: 0.0,
+                domain,
+                resolution: 32,
+                auto_resolution: false,
+                options: Options {
+                    self_intersection: true,
+                    instancing: true,
+                    ..Default::default()
+                },
+            };
             let mut sink = MeshCollector::default();
-            let written = pipeline::write(
-                &family,
-                solved.best,
-                voxel,
-                route,
-                &opts,
-                &Progress::hidden(),
-                &mut sink,
-            )
-            .unwrap();
+            let report = job.run_into(&Progress::hidden(), &mut sink).unwrap();
             let tris = triangles(&sink);
             let fraction = volume(&tris) / 15f64.powi(3);
             let e = edges(&tris);
@@ -78,15 +63,15 @@ fn every_built_in_cell_meets_its_density_closed_and_in_one_piece() {
                         .max((hi[a] - bounds.max[a]).abs())
                 })
                 .fold(0.0, f64::max);
-            let ctx = format!("{name} at {target} (radius {radius:.4} mm)");
+            let ctx = format!("{name} at {target} (radius {:.4} mm)", report.radius);
             if (fraction - target).abs() > 0.002 {
                 failures.push(format!("{ctx}: density {fraction:.5}"));
             }
             if e.boundary + e.non_manifold + e.same_direction > 0 {
                 failures.push(format!("{ctx}: edges {e:?}"));
             }
-            if !written.checks.verdict().is_valid_solid() {
-                failures.push(format!("{ctx}: CGAL finds {:?}", written.checks));
+            if !report.part.checks.verdict().is_valid_solid() {
+                failures.push(format!("{ctx}: CGAL finds {:?}", report.part.checks));
             }
             let n = pieces(&tris);
             if n != 1 {

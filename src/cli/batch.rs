@@ -12,6 +12,7 @@
 
 use super::out::outln;
 use super::repair::RepairArgs;
+use super::strut::StrutArgs;
 use super::topo::TopoArgs;
 use super::tpms::TpmsArgs;
 use clap::{Args, FromArgMatches};
@@ -55,8 +56,8 @@ Job file (paths relative to it; keys are the subcommand's long options):
   output = \"out/scan-fixed.stl\"
   drop-open-shells = true
 
-Jobs run the subcommands that make a part: tpms, topo and repair, with the options of
-`latvox tpms`, `latvox topo` and `latvox repair` (`input` is the input file).
+Jobs run the subcommands that make a part: tpms, strut, topo and repair, with the options of
+`latvox tpms`, `latvox strut`, `latvox topo` and `latvox repair` (`input` is the input file).
 
 Examples:
   latvox batch jobs.toml                       # run all jobs, 1 worker per thread
@@ -113,18 +114,30 @@ type ParseJob = fn(&'static str, &Job) -> std::result::Result<Box<dyn Task>, Str
 /// The subcommands a job file can run: those that make a part.
 const COMMANDS: &[(&str, ParseJob)] = &[
     ("tpms", parse_job::<TpmsArgs>),
+    ("strut", parse_job::<StrutArgs>),
     ("topo", parse_job::<TopoArgs>),
     ("repair", parse_job::<RepairArgs>),
 ];
 
 impl Task for TpmsArgs {
     fn outputs(&self) -> Vec<PathBuf> {
-        vec![self.output.clone()]
+        vec![self.mesh.output.clone()]
     }
 
     fn run(&self) -> Result<TaskReport> {
         let r = super::tpms::execute(self, &Progress::hidden())?;
-        TaskReport::new(&r, &r.verdict(), r.warnings.clone())
+        TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
+    }
+}
+
+impl Task for StrutArgs {
+    fn outputs(&self) -> Vec<PathBuf> {
+        vec![self.mesh.output.clone()]
+    }
+
+    fn run(&self) -> Result<TaskReport> {
+        let r = super::strut::execute(self, &Progress::hidden())?;
+        TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
     }
 }
 
@@ -472,11 +485,11 @@ mod tests {
             .try_get_matches_from_mut(command_line(&cmd, &j).unwrap())
             .unwrap();
         let a = TpmsArgs::from_arg_matches(&m).unwrap();
-        assert_eq!(a.cells, Some([4, 4, 2]));
-        assert_eq!(a.cell_size, Some([6.0; 3]));
-        assert_eq!(a.origin, [-5.0, 0.0, 2.5]);
+        assert_eq!(a.domain.cells, Some([4, 4, 2]));
+        assert_eq!(a.domain.cell_size, Some([6.0; 3]));
+        assert_eq!(a.domain.origin, [-5.0, 0.0, 2.5]);
         assert_eq!(a.density, 0.25);
-        assert!(a.ascii);
+        assert!(a.mesh.ascii);
         assert!(!a.allow_islands);
 
         let bad = job("[[job]]\ncommand='tpms'\noutput='a.stl'\ncell_sise=5\n");

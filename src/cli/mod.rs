@@ -3,8 +3,10 @@
 
 pub mod batch;
 pub mod check;
+pub mod lattice;
 pub(crate) mod out;
 pub mod repair;
+pub mod strut;
 pub mod topo;
 pub mod topopt;
 pub mod tpms;

@@ -6,7 +6,10 @@
 //! clearance never overestimates, a skipped block can never hide a piece of surface (a skipped
 //! block that the surface crossed would be a hole in the mesh).
 
+pub mod domain;
 pub mod periodic;
+
+pub use domain::Domain;
 
 /// A point or vector in millimetres.
 pub type Vec3 = [f64; 3];

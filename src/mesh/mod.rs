@@ -4,7 +4,9 @@
 //! vertex named by its voxel and edge group, [`snap`] moves the vertices onto the exact surface,
 //! [`tile`] and [`instance`] mesh large parts in pieces that weld exactly, [`pieces`] finds the
 //! fragments a box cuts loose, and [`pipeline`] puts them together: any clipped field to a
-//! verified mesh at its target density, streamed to a sink. [`topology`] and [`triangulate`]
+//! verified mesh at its target density, streamed to a sink, at the resolution [`resolution`]
+//! finds it needs,
+//! reported the same way for every capability ([`report`]). [`topology`] and [`triangulate`]
 //! serve the checks and the readers.
 
 pub mod extract;
@@ -12,6 +14,8 @@ mod indexed;
 pub mod instance;
 pub mod pieces;
 pub mod pipeline;
+pub mod report;
+pub mod resolution;
 pub mod snap;
 pub mod tile;
 pub mod topology;

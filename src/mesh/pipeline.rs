@@ -473,43 +473,6 @@ pub fn solve<F: Family>(
     })
 }
 
-/// The smallest resolution from `start` up to `limit` at which `attempt` finds the part (its
-/// result), or `None`: `start` first, then steps that double until one works, then bisection
-/// between the last that failed and the first that worked — so the resolution returned works
-/// and the one below it (when above `start`) does not.
-pub fn smallest_resolution<T>(
-    start: u32,
-    limit: u32,
-    attempt: &mut impl FnMut(u32) -> Result<Option<T>>,
-) -> Result<Option<(u32, T)>> {
-    if let Some(t) = attempt(start)? {
-        return Ok(Some((start, t)));
-    }
-    let mut failed = start;
-    let mut step = (start / 4).max(1);
-    let mut worked = loop {
-        if failed >= limit {
-            return Ok(None);
-        }
-        let r = (failed + step).min(limit);
-        match attempt(r)? {
-            Some(t) => break (r, t),
-            None => {
-                failed = r;
-                step *= 2;
-            }
-        }
-    };
-    while worked.0 - failed > 1 {
-        let mid = failed + (worked.0 - failed) / 2;
-        match attempt(mid)? {
-            Some(t) => worked = (mid, t),
-            None => failed = mid,
-        }
-    }
-    Ok(Some(worked))
-}
-
 /// Timings and checks of writing a part.
 pub struct Written {
     /// CGAL's checks (on the template when copied; counted per tile when tiled).

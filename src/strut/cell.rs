@@ -121,6 +121,46 @@ fn dist(a: Vec3, b: Vec3) -> f64 {
     (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt()
 }
 
+/// An integer lattice given by generators, kept in echelon form (Hermite's normal form, up to
+/// the rows' signs), to tell its rank and index in Z³.
+#[derive(Default)]
+struct IntegerLattice {
+    /// Row `k`, when present, has its first nonzero entry in column `k`.
+    rows: [Option<[i64; 3]>; 3],
+}
+
+impl IntegerLattice {
+    /// Adds a generator.
+    fn add(&mut self, mut v: [i64; 3]) {
+        for k in 0..3 {
+            if v[k] == 0 {
+                continue;
+            }
+            let Some(mut row) = self.rows[k] else {
+                self.rows[k] = Some(v);
+                return;
+            };
+            // Euclid on the column-k entries of the row and v, carrying the whole vectors.
+            while v[k] != 0 {
+                let q = row[k].div_euclid(v[k]);
+                let r = [0, 1, 2].map(|c| row[c] - q * v[c]);
+                row = v;
+                v = r;
+            }
+            self.rows[k] = Some(row);
+        }
+    }
+
+    /// The index of the lattice in Z³ (how many cosets), or `None` below rank 3.
+    fn index(&self) -> Option<u64> {
+        let mut d = 1u64;
+        for k in 0..3 {
+            d *= self.rows[k]?[k].unsigned_abs();
+        }
+        Some(d)
+    }
+}
+
 /// The truncated octahedron of the body-centred packing (Kelvin's cell): the 24 points
 /// `(½, ½, ½) + (0, ±¼, ±½)` in every order of the axes, joined at distance √2/4.
 fn kelvin() -> Vec<[Vec3; 2]> {
@@ -359,12 +399,79 @@ impl UnitCell {
                 r
             }
         };
-        Ok(UnitCell {
+        let cell = UnitCell {
             nodes: f.nodes,
             struts: f.struts,
             radii,
         }
-        .canonical())
+        .canonical();
+        match cell.separate_lattices() {
+            Some(1) => Ok(cell),
+            Some(n) => Err(Error::parse(format!(
+                "the struts make {n} separate lattices that pass through each other without a shared node (struts that cross must meet at a node)"
+            ))),
+            None => Err(Error::parse(
+                "the struts do not join into one lattice when the cell is repeated: they form separate layers, chains or pieces (struts that cross must meet at a node)",
+            )),
+        }
+    }
+
+    /// How many separate lattices the struts make when the cell is repeated in every
+    /// direction, joined at shared nodes: `Some(1)` for one lattice, `Some(n)` for `n` that
+    /// interpenetrate without a shared node, `None` for struts that do not reach across the
+    /// cell in all three directions (layers, chains, or isolated pieces: infinitely many).
+    ///
+    /// Each node stands for its translates; a breadth-first walk over the struts gives each
+    /// node the translate it is reached at, and each strut that closes a loop adds the
+    /// translation around the loop. The lattice is one when those translations generate every
+    /// whole-cell translation: their integer lattice has rank 3 and index 1 (the index is
+    /// the number of separate lattices).
+    pub fn separate_lattices(&self) -> Option<u64> {
+        // Nodes by their place in the cell, and the whole-cell shift of each.
+        let mut places: Vec<[i64; 3]> = Vec::new();
+        let mut place_of = Vec::with_capacity(self.nodes.len());
+        let mut shift_of = Vec::with_capacity(self.nodes.len());
+        for p in &self.nodes {
+            let key = p.map(|x| ((x * 1e9).round() as i64).rem_euclid(1_000_000_000));
+            let shift = [0, 1, 2].map(|k| ((p[k] * 1e9).round() as i64).div_euclid(1_000_000_000));
+            let place = places.iter().position(|q| *q == key).unwrap_or_else(|| {
+                places.push(key);
+                places.len() - 1
+            });
+            place_of.push(place);
+            shift_of.push(shift);
+        }
+        let used: std::collections::BTreeSet<usize> =
+            self.struts.iter().flatten().map(|&i| place_of[i]).collect();
+        // Struts between places, with the translation from the first end's copy to the second's.
+        let mut adjacent: Vec<Vec<(usize, [i64; 3])>> = vec![Vec::new(); places.len()];
+        for &[i, j] in &self.struts {
+            let t = [0, 1, 2].map(|k| shift_of[j][k] - shift_of[i][k]);
+            adjacent[place_of[i]].push((place_of[j], t));
+            adjacent[place_of[j]].push((place_of[i], t.map(|x| -x)));
+        }
+        let start = *used.iter().next()?;
+        let mut at: Vec<Option<[i64; 3]>> = vec![None; places.len()];
+        at[start] = Some([0; 3]);
+        let mut queue = std::collections::VecDeque::from([start]);
+        let mut basis = IntegerLattice::default();
+        while let Some(a) = queue.pop_front() {
+            let oa = at[a].expect("queued nodes are placed");
+            for &(b, t) in &adjacent[a] {
+                let reached = [0, 1, 2].map(|k| oa[k] + t[k]);
+                match at[b] {
+                    None => {
+                        at[b] = Some(reached);
+                        queue.push_back(b);
+                    }
+                    Some(ob) => basis.add([0, 1, 2].map(|k| reached[k] - ob[k])),
+                }
+            }
+        }
+        if used.iter().any(|&p| at[p].is_none()) {
+            return None;
+        }
+        basis.index()
     }
 
     /// The cell as struts of a lattice with cells of `size` mm: each strut's ends in mm,
@@ -404,6 +511,56 @@ mod tests {
             let c = UnitCell::built_in(name).unwrap();
             assert_eq!(c.struts.len(), n, "{name}");
         }
+    }
+
+    #[test]
+    fn built_in_cells_are_one_lattice_and_broken_cells_are_not() {
+        for name in BUILT_IN {
+            let c = UnitCell::built_in(name).unwrap();
+            assert_eq!(c.separate_lattices(), Some(1), "{name}");
+        }
+        let cell = |nodes: &[Vec3], struts: &[[usize; 2]]| {
+            UnitCell {
+                nodes: nodes.to_vec(),
+                struts: struts.to_vec(),
+                radii: vec![1.0; nodes.len()],
+            }
+            .canonical()
+        };
+        // Chains along x only; layers in the plane x = 0 ... spanned by (1,0,0) and (0,1,1).
+        let chain = cell(&[[0.0; 3], [1.0, 0.0, 0.0]], &[[0, 1]]);
+        assert_eq!(chain.separate_lattices(), None);
+        let layers = cell(
+            &[[0.5; 3], [1.5, 0.5, 0.5], [0.5, 1.5, 1.5], [1.5, 1.5, 1.5]],
+            &[[0, 1], [0, 2], [0, 3]],
+        );
+        assert_eq!(layers.separate_lattices(), None);
+        // Struts joining each point to its translates by (2,0,0)-style steps: the body-centred
+        // sub-lattice {(a, b, c): a + b + c even} of sc, two lattices.
+        let two = cell(
+            &[[0.0; 3], [1.0, 1.0, 0.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]],
+            &[[0, 1], [0, 2], [0, 3]],
+        );
+        assert_eq!(two.separate_lattices(), Some(2));
+        // A node not joined to the rest: isolated pieces.
+        let island = cell(
+            &[
+                [0.0; 3],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [0.3; 3],
+                [0.6; 3],
+            ],
+            &[[0, 1], [0, 2], [0, 3], [4, 5]],
+        );
+        assert_eq!(island.separate_lattices(), None);
+        assert!(UnitCell::from_json(
+            r#"{"nodes": [[0,0,0],[1,1,0],[1,0,1],[0,1,1]], "struts": [[0,1],[0,2],[0,3]]}"#
+        )
+        .unwrap_err()
+        .to_string()
+        .contains("2 separate lattices"));
     }
 
     #[test]

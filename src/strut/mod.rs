@@ -1,10 +1,13 @@
 //! Strut (beam) lattices: unit cells of struts ([`cell`]) and the lattice as a periodic field
-//! evaluated in one cell ([`field`]), for the meshing pipeline.
+//! evaluated in one cell ([`field`]), the part at every radius for the meshing pipeline
+//! ([`lattice`]) and the job that makes a part to a density or radius ([`job`]).
 
 pub mod cell;
 pub mod field;
+pub mod job;
 pub mod lattice;
 
 pub use cell::UnitCell;
 pub use field::StrutField;
+pub use job::{Sizing, StrutJob, StrutReport};
 pub use lattice::{RadiusModel, StrutFamily, StrutLattice};

@@ -3,15 +3,13 @@
 //! reach it), mesh, verify, write and report — the meshing itself is [`crate::mesh::pipeline`]'s.
 
 use super::calibrate::{self, Calibration, Connectivity, FeasibleRange};
-use super::{Domain, Lattice, LatticeFamily, MeshingStats, Structure, Surface};
-use crate::check::cgal::Verification;
+use super::{Domain, Lattice, LatticeFamily, Structure, Surface};
 use crate::check::Verdict;
 use crate::error::{Error, Result};
-use crate::field::Aabb;
 use crate::io::sink::{MeshCollector, MeshSink};
-use crate::mesh::instance;
-use crate::mesh::pieces::Fragments;
-use crate::mesh::pipeline::{self, Options, Route, Solved, PROMISE};
+use crate::mesh::pipeline::{self, Options, Route, Solved};
+use crate::mesh::report::{LevelSearch, PartReport, Timings};
+use crate::mesh::resolution;
 use crate::mesh::Mesh;
 use crate::progress::Progress;
 use std::time::Instant;
@@ -55,47 +53,6 @@ pub struct TpmsJob {
     pub keep_fragments: bool,
 }
 
-/// Timings per stage, seconds.
-#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
-pub struct Timings {
-    /// The unit cell's sample table and the calibration's meshings.
-    pub calibrate: f64,
-    /// Sampling the field into OpenVDB grids.
-    pub sample: f64,
-    /// OpenVDB's meshing.
-    pub mesh: f64,
-    /// Snapping the vertices onto the surface and box.
-    pub snap: f64,
-    /// CGAL's checks.
-    pub verify: f64,
-    /// Writing the part.
-    pub write: f64,
-    /// The whole job.
-    pub total: f64,
-}
-
-/// How the level of the part was found: the part (or a template of its cells) meshed at each
-/// level tried, and the volume fraction measured.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct LevelSearch {
-    /// What was measured: `part` (the whole part), `template` (a template of its cells, which
-    /// gives the part's volume) or `tiles` (the part meshed tile by tile, not kept).
-    pub measured_on: &'static str,
-    /// `[level, volume fraction]` of each meshing, in order.
-    pub tried: Vec<[f64; 2]>,
-    /// Resolutions tried before the one used, with the closest fraction each could give.
-    pub coarser: Vec<ResolutionMiss>,
-}
-
-/// A resolution at which no level gave the target density.
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct ResolutionMiss {
-    /// Voxels per cell.
-    pub resolution: u32,
-    /// The closest volume fraction found.
-    pub closest: f64,
-}
-
 /// The JSON report of a TPMS job.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct TpmsReport {
@@ -106,15 +63,6 @@ pub struct TpmsReport {
     pub structure: Structure,
     /// The level `t` the part was written at.
     pub level: f64,
-    /// The volume fraction asked for.
-    pub target_density: f64,
-    /// Volume fraction of the written mesh: its enclosed volume (divergence theorem over the
-    /// triangles exactly as written) over the box volume.
-    pub achieved_density: f64,
-    /// `achieved_density − target_density`.
-    pub density_error: f64,
-    /// Whether the written mesh is within 0.002 of the target density.
-    pub density_met: bool,
     /// The first guess of the level, from the unit cell.
     pub calibration: Calibration,
     /// How the part's level was found.
@@ -135,50 +83,16 @@ pub struct TpmsReport {
     pub cell_size: [f64; 3],
     /// Cells per axis (fractional where the box ends inside a cell).
     pub cells: [f64; 3],
-    /// The part's box, mm.
-    #[serde(rename = "box")]
-    pub bounds: Aabb,
-    /// Triangles written.
-    pub triangles: u64,
-    /// Vertices of the part.
-    pub vertices: u64,
-    /// Surface area of the written mesh, mm².
-    pub area: f64,
-    /// Volume enclosed by the written mesh, mm³.
-    pub volume: Option<f64>,
-    /// Bounding box of the written mesh, mm (`null` when empty).
-    pub bounding_box: Option<Aabb>,
-    /// CGAL's checks: on the written mesh, or on the template when `instancing` is set.
-    pub checks: Verification,
-    /// Pieces of the lattice the box cut loose: removed (unless kept with `keep_fragments`).
-    pub fragments: Fragments,
-    /// Whether what was written is one piece (`null` where it was not checked: a part meshed in
-    /// tiles without a template of its cells).
-    pub one_piece: Option<bool>,
-    /// Set when the part was copied from a template.
-    pub instancing: Option<Instancing>,
-    /// Set when the part was meshed in tiles.
-    pub tiling: Option<Tiling>,
-    /// Meshing statistics over every meshing of the job.
-    pub meshing: MeshingStats,
-    /// Wall time of each stage.
-    pub timings: Timings,
-    /// Warnings, one sentence each (islands, raised resolution, …).
-    pub warnings: Vec<String>,
-    /// The output file, when the command line wrote one.
-    pub output: Option<String>,
+    /// The part as written: density, mesh, checks, timings, warnings.
+    #[serde(flatten)]
+    pub part: PartReport,
 }
 
 impl TpmsReport {
     /// The part's verdict: CGAL's checks (on the part, its template or its tiles), one piece
     /// (unless fragments were kept on purpose), and the density.
     pub fn verdict(&self) -> Verdict {
-        let kept_on_purpose = !self.fragments.removed && self.fragments.count > 0;
-        Verdict {
-            one_piece: self.one_piece.filter(|_| !kept_on_purpose),
-            density_met: Some(self.density_met),
-            ..self.checks.verdict()
-        }
+        self.part.verdict()
     }
 }
 
@@ -232,15 +146,33 @@ impl TpmsJob {
             // Islands asked for are kept: the solid is meant to fall apart.
             keep_fragments: self.keep_fragments || !conn.solid,
         };
-        let search = self.search_resolution(t0, &opts, progress)?;
-        warnings.extend(search.raised);
+        let mut calibrate_seconds = table_seconds;
+        let request = resolution::Request {
+            part: format!("the {} {}", s.name(), st.name()),
+            setting: format!("density {}", self.density),
+            requested: self.resolution,
+            thin: self.thin_walls(t0),
+            density: Some(self.density),
+            auto: self.auto_resolution,
+        };
+        let resolved = resolution::search(&request, &mut |r| {
+            let _p = progress.stage(if r == self.resolution {
+                "calibrating and meshing"
+            } else {
+                "searching for a resolution that reaches the density"
+            });
+            let (cal_seconds, outcome) = self.attempt(r, &opts)?;
+            calibrate_seconds += cal_seconds;
+            Ok(outcome)
+        })?;
+        warnings.extend(resolved.raised);
         let Found {
             voxel,
             cal,
             family,
             route,
             solved,
-        } = search.found;
+        } = resolved.found;
         let Solved {
             best,
             tried,
@@ -248,72 +180,37 @@ impl TpmsJob {
             ..
         } = solved;
         let level = best.level;
-        let measured_on = match (&best.made, route) {
-            (pipeline::Made::Whole(_), _) => "part",
-            (_, Route::Tiled(_, None)) => "tiles",
-            _ => "template",
-        };
+        let level_search = LevelSearch::new(&best, route, &tried, resolved.coarser);
         let written = pipeline::write(&family, best, voxel, route, &opts, progress, sink)?;
-        // The meshings of the search are part of the work (the whole route's last one is the
-        // part's own mesh).
-        let mut all_meshing = search_meshing;
-        if !matches!(route, Route::Whole(None)) {
-            all_meshing.add(&written.meshing);
-        }
-        let bounds = self.domain.bounds();
-        let measures = written.measures;
-        let achieved = measures.volume / bounds.volume();
-        let density_met = (achieved - self.density).abs() <= PROMISE;
-        let one_piece = match route {
-            Route::Tiled(_, None) => None,
-            _ => Some(written.fragments.count == 0 || written.fragments.removed),
-        };
-        warnings.extend(self.written_warnings(achieved, &written));
+        let mut part = PartReport::new(
+            self.domain.bounds(),
+            Some(self.density),
+            route,
+            written,
+            search_meshing,
+            Timings {
+                calibrate: calibrate_seconds,
+                ..Timings::default()
+            },
+        );
+        warnings.append(&mut part.warnings);
+        part.warnings = warnings;
+        part.timings.total = start.elapsed().as_secs_f64();
         Ok(TpmsReport {
             surface: s,
             structure: st,
             level,
-            target_density: self.density,
-            achieved_density: achieved,
-            density_error: achieved - self.density,
-            density_met,
             calibration: cal,
-            level_search: LevelSearch {
-                measured_on,
-                tried: tried.iter().map(|&(t, f)| [t, f]).collect(),
-                coarser: search.coarser,
-            },
+            level_search,
             feasible_range: range,
             connectivity: conn,
             resolution_requested: self.resolution,
-            resolution: search.resolution,
+            resolution: resolved.resolution,
             voxel_size: voxel,
-            thinnest_wall_voxels: wall_voxels(s, st, t0, search.resolution),
+            thinnest_wall_voxels: wall_voxels(s, st, t0, resolved.resolution),
             cell_size: self.domain.cell,
             cells: self.domain.counts(),
-            bounds,
-            triangles: measures.triangles,
-            vertices: written.vertices,
-            area: measures.area,
-            volume: Some(measures.volume),
-            bounding_box: (measures.triangles > 0).then_some(measures.bounds),
-            checks: written.checks,
-            fragments: written.fragments,
-            one_piece,
-            instancing: written.instancing,
-            tiling: written.tiling,
-            timings: Timings {
-                calibrate: table_seconds + search.calibrate_seconds,
-                sample: all_meshing.sample_seconds,
-                mesh: all_meshing.mesh_seconds,
-                snap: all_meshing.snap_seconds,
-                verify: written.verify_seconds,
-                write: written.write_seconds,
-                total: start.elapsed().as_secs_f64(),
-            },
-            meshing: all_meshing,
-            warnings,
-            output: None,
+            part,
         })
     }
 
@@ -349,130 +246,17 @@ impl TpmsJob {
         Ok((conn, warnings))
     }
 
-    /// The level is found on the part at the requested resolution; where sheet walls are too
-    /// thin or no level reaches the target on these voxels, finer ones are searched (steps that
-    /// double, then bisection), and the smallest that works is used (or, with a fixed
-    /// resolution, named in the refusal).
-    fn search_resolution(
-        &self,
-        t0: f64,
-        opts: &Options,
-        progress: &Progress,
-    ) -> Result<ResolutionSearch> {
-        let (s, st) = (self.surface, self.structure);
-        let mut passed_over: Vec<String> = Vec::new();
-        let mut start_at = self.resolution;
-        // Sheet walls thinner than MIN_WALL_VOXELS perforate; a resolution that leaves them so
-        // is passed over without meshing.
-        if let Some(w) = wall_voxels(s, st, t0, start_at).filter(|&w| w < MIN_WALL_VOXELS) {
-            let needed = (start_at as f64 * MIN_WALL_VOXELS / w).ceil() as u32;
-            passed_over.push(format!(
-                "sheet walls were {w:.2} voxels thin at {start_at} voxels per cell"
-            ));
-            // Raised to whole 8-voxel blocks, so that cells can still be copied exactly; a
-            // refusal names the smallest that works.
-            start_at = if self.auto_resolution {
-                needed.div_ceil(instance::BLOCK) * instance::BLOCK
-            } else {
-                needed
-            };
-        }
-        let limit = max_resolution(self.resolution).max(start_at);
-        let mut coarser = Vec::new();
-        let mut calibrate_seconds = 0.0;
-        let mut attempt = |r: u32| -> Result<Option<Found>> {
-            let _p = progress.stage(if r == self.resolution {
-                "calibrating and meshing"
-            } else {
-                "searching for a resolution that reaches the density"
-            });
-            let (cal_seconds, outcome) = self.attempt(r, opts)?;
-            calibrate_seconds += cal_seconds;
-            Ok(match outcome {
-                Ok(found) => Some(found),
-                Err(closest) => {
-                    coarser.push(ResolutionMiss {
-                        resolution: r,
-                        closest,
-                    });
-                    None
-                }
-            })
-        };
-        let Some((resolution, found)) =
-            pipeline::smallest_resolution(start_at, limit, &mut attempt)?
-        else {
-            let closest = coarser.last().map_or(f64::NAN, |m| m.closest);
-            return Err(Error::invalid(format!(
-                "no level gives the {} {} a density of {} within {PROMISE} at {} to {limit} voxels per cell (closest {closest:.4}); the box may cut the lattice into pieces",
-                s.name(),
-                st.name(),
-                self.density,
-                self.resolution,
-            )));
-        };
-        coarser.sort_by_key(|m| m.resolution);
-        if let Some(miss) = coarser.first().filter(|m| m.resolution == start_at) {
-            passed_over.push(format!(
-                "at {} voxels per cell no level gives density {} (closest {:.4}): the voxels are too coarse for the lattice's members",
-                miss.resolution, self.density, miss.closest
-            ));
-        }
-        let mut raised = Vec::new();
-        if let Some(why) = passed_over.first() {
-            if !self.auto_resolution {
-                return Err(Error::invalid(format!(
-                    "the {} {} at density {}: {why}; use --resolution {resolution}, the smallest that works",
-                    s.name(),
-                    st.name(),
-                    self.density
-                )));
-            }
-            raised.push(format!(
-                "resolution raised from {} to {resolution} voxels per cell: {why}",
-                self.resolution
-            ));
-        }
-        Ok(ResolutionSearch {
-            resolution,
-            found,
-            coarser,
-            calibrate_seconds,
-            raised,
+    /// The resolution sheet walls need, when the requested one leaves them thinner than
+    /// [`MIN_WALL_VOXELS`] (they perforate), and why.
+    fn thin_walls(&self, t0: f64) -> Option<(u32, String)> {
+        let r = self.resolution;
+        let w = wall_voxels(self.surface, self.structure, t0, r)?;
+        (w < MIN_WALL_VOXELS).then(|| {
+            (
+                (r as f64 * MIN_WALL_VOXELS / w).ceil() as u32,
+                format!("sheet walls were {w:.2} voxels thin at {r} voxels per cell"),
+            )
         })
-    }
-
-    /// What the written mesh says that the user should hear: a missed density (a bug), a
-    /// failed CGAL check, fragments cut loose by the box.
-    fn written_warnings(&self, achieved: f64, written: &pipeline::Written) -> Vec<String> {
-        let mut warnings = Vec::new();
-        if (achieved - self.density).abs() > PROMISE {
-            warnings.push(format!(
-                "the written mesh's density {achieved:.4} misses the target {} by more than {PROMISE}: please report this",
-                self.density
-            ));
-        }
-        if !written.checks.verdict().is_valid_solid() {
-            warnings.push(
-                "CGAL did not find the mesh a valid closed, outward, self-intersection-free solid"
-                    .into(),
-            );
-        }
-        let fragments = &written.fragments;
-        if fragments.count > 0 {
-            warnings.push(format!(
-                "{} fragment{} cut loose by the box ({:.3} mm³) {}",
-                fragments.count,
-                if fragments.count == 1 { "" } else { "s" },
-                fragments.volume,
-                if fragments.removed {
-                    "removed"
-                } else {
-                    "kept: they are not joined to the part"
-                }
-            ));
-        }
-        warnings
     }
 
     /// Calibrates a first level at `resolution` and searches the level for the part from it:
@@ -537,23 +321,7 @@ struct Found {
     solved: Solved,
 }
 
-/// The outcome of the resolution search: the resolution used and the part found there, the
-/// coarser resolutions that missed, the seconds spent calibrating, and the warning when the
-/// resolution was raised.
-struct ResolutionSearch {
-    resolution: u32,
-    found: Found,
-    coarser: Vec<ResolutionMiss>,
-    calibrate_seconds: f64,
-    raised: Vec<String>,
-}
-
 /// Sheet walls' thinnest width in voxels at `resolution` (nets: none).
 fn wall_voxels(s: Surface, st: Structure, t0: f64, resolution: u32) -> Option<f64> {
     (st == Structure::Sheet).then(|| calibrate::thinnest_sheet_wall(s, t0) * resolution as f64)
-}
-
-/// The finest resolution tried before a part is refused.
-fn max_resolution(requested: u32) -> u32 {
-    (4 * requested).max(64)
 }

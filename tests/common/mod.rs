@@ -1,5 +1,5 @@
 //! Test helpers that do not use latvox's own code: an STL reader, edge counting by hash map,
-//! volume by the divergence theorem, and the seed's TPMS formulas written out directly.
+//! volume by the divergence theorem, the TPMS formulas written out directly, a seeded generator.
 #![allow(dead_code)]
 
 pub mod child;
@@ -202,4 +202,23 @@ pub fn files_in(dir: &Path) -> Vec<PathBuf> {
         .collect();
     v.sort();
     v
+}
+
+/// splitmix64: a small, well-mixed generator, enough to draw cases reproducibly.
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
 }

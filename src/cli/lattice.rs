@@ -1,0 +1,218 @@
+//! What the lattice commands (`tpms`, `strut`) share: the box of cells, the meshing and output
+//! options, writing the part atomically with its report, and the summary of the part written.
+
+use super::out::outln;
+use super::{
+    cgal_findings, parse_counts, parse_finite3, parse_positive3, parse_size, parse_tile,
+    parse_unit, write_json,
+};
+use clap::Args;
+use latvox::field::Domain;
+use latvox::io::sink::{MeshFile, MeshSink};
+use latvox::mesh::pipeline::Options;
+use latvox::mesh::report::PartReport;
+use latvox::{Error, Result};
+use std::path::PathBuf;
+
+/// The box: two of cells, cell size and overall size, and the lower corner.
+#[derive(Args, Clone)]
+pub struct BoxArgs {
+    /// Cells per axis: N or NX,NY,NZ.
+    #[arg(long, value_name = "N[,NY,NZ]", value_parser = parse_counts, allow_hyphen_values = true)]
+    pub cells: Option<[u32; 3]>,
+    /// Cell size in mm: A or AX,AY,AZ.
+    #[arg(long, value_name = "MM[,MM,MM]", value_parser = parse_positive3, allow_hyphen_values = true)]
+    pub cell_size: Option<[f64; 3]>,
+    /// Overall box size in mm (with --cells or --cell-size): S or SX,SY,SZ.
+    #[arg(long, value_name = "MM[,MM,MM]", value_parser = parse_positive3, allow_hyphen_values = true)]
+    pub size: Option<[f64; 3]>,
+    /// Lower corner of the box in mm (lattice phase starts there).
+    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,0", value_parser = parse_finite3, allow_hyphen_values = true)]
+    pub origin: [f64; 3],
+}
+
+impl BoxArgs {
+    /// The box the options give (4×4×4 cells of 5 mm by default).
+    pub fn domain(&self) -> Result<Domain> {
+        let o = self.origin;
+        match (self.cells, self.cell_size, self.size) {
+            (Some(n), Some(c), None) => Domain::from_cells(n, c, o),
+            (Some(n), None, Some(s)) => Domain::from_size_and_cells(s, n, o),
+            (None, Some(c), Some(s)) => Domain::from_size_and_cell(s, c, o),
+            (Some(n), None, None) => Domain::from_cells(n, [5.0; 3], o),
+            (None, Some(c), None) => Domain::from_cells([4; 3], c, o),
+            (None, None, None) => Domain::from_cells([4; 3], [5.0; 3], o),
+            (None, None, Some(_)) => Err(Error::invalid("--size needs --cells or --cell-size")),
+            (Some(_), Some(_), Some(_)) => Err(Error::invalid(
+                "give two of --cells, --cell-size, --size, not all three",
+            )),
+        }
+    }
+}
+
+/// How the part is meshed, checked and written.
+#[derive(Args, Clone)]
+pub struct MeshArgs {
+    /// Voxels per cell along the cell's shortest side.
+    #[arg(long, short = 'r', default_value_t = 32, value_parser = clap::value_parser!(u32).range(4..=4096))]
+    pub resolution: u32,
+    /// Fail instead of raising the resolution when the lattice's members would be too thin
+    /// for the voxels.
+    #[arg(long)]
+    pub fixed_resolution: bool,
+    /// OpenVDB mesh adaptivity: 0 keeps uniform triangles, up to 1 merges flat regions.
+    #[arg(long, default_value_t = 0.0, value_parser = parse_unit)]
+    pub adaptivity: f64,
+    /// Output mesh, in the format its extension names: .stl (binary, ASCII with --ascii) or
+    /// .3mf, streamed to the file as it is made; .obj, .off or .ply (binary, ASCII with
+    /// --ascii), written once the part is whole.
+    #[arg(
+        long,
+        short = 'o',
+        value_name = "FILE.stl|.3mf|.obj|.off|.ply",
+        default_value = "lattice.stl"
+    )]
+    pub output: PathBuf,
+    /// Write ASCII STL (or ASCII PLY) instead of binary.
+    #[arg(long)]
+    pub ascii: bool,
+    /// Write a JSON report (settings, densities, mesh counts, CGAL checks, timings).
+    #[arg(long, value_name = "FILE.json")]
+    pub report: Option<PathBuf>,
+    /// Skip CGAL's self-intersection test (the slowest check) on very large meshes.
+    #[arg(long)]
+    pub no_self_intersection_check: bool,
+    /// Mesh the whole part at once instead of copying its periodic cells from a meshed
+    /// 3×3×3-cell template (slower, same solid; CGAL then checks the whole part).
+    #[arg(long)]
+    pub no_instancing: bool,
+    /// Memory budget while meshing, e.g. 2G or 512M: a part whose grid would not fit is meshed
+    /// in tiles sized from it and streamed to the file (default 4G).
+    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+    pub memory: Option<u64>,
+    /// Mesh in tiles of this many voxels a side (a multiple of 8, at least 16), whatever the
+    /// part's size; the tiled part is the same solid as the untiled one.
+    #[arg(long, value_name = "VOXELS", value_parser = parse_tile)]
+    pub tile: Option<i64>,
+    /// Keep the pieces the box cuts loose from the lattice (by default they are removed, so
+    /// that the part is one piece; the summary and report count them either way).
+    #[arg(long)]
+    pub keep_fragments: bool,
+}
+
+impl MeshArgs {
+    /// The pipeline's options.
+    pub fn options(&self) -> Options {
+        Options {
+            adaptivity: self.adaptivity,
+            self_intersection: !self.no_self_intersection_check,
+            instancing: !self.no_instancing,
+            tile: self.tile,
+            memory: self.memory,
+            keep_fragments: self.keep_fragments,
+        }
+    }
+
+    /// Fails on an unwritable report before the work, not after.
+    pub fn check_report(&self) -> Result<()> {
+        match &self.report {
+            Some(r) => latvox::io::atomic::check_writable(r),
+            None => Ok(()),
+        }
+    }
+
+    /// Runs `job` into the output file: a temporary file that becomes the output only once the
+    /// job is done; `part` gives the job's report's part, to note the output in.
+    pub fn write<R>(
+        &self,
+        job: impl FnOnce(&mut dyn MeshSink) -> Result<R>,
+        part: impl FnOnce(&mut R) -> &mut PartReport,
+    ) -> Result<R> {
+        latvox::io::atomic::check_writable(&self.output)?;
+        let mut sink = MeshFile::new(&self.output, self.ascii)?.sink()?;
+        let mut report = job(&mut sink)?;
+        sink.commit()?;
+        part(&mut report).output = Some(self.output.display().to_string());
+        Ok(report)
+    }
+
+    /// Writes the JSON report (when asked for) and the warnings; returns the exit code.
+    pub fn finish(&self, report: &impl serde::Serialize, part: &PartReport) -> Result<i32> {
+        if let Some(r) = &self.report {
+            write_json(r, report)?;
+        }
+        for w in &part.warnings {
+            eprintln!("latvox: warning: {w}");
+        }
+        Ok(part.verdict().exit_code())
+    }
+}
+
+/// A number for people: at most `digits` decimals, trailing zeros dropped.
+pub(crate) fn human(x: f64, digits: usize) -> String {
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// A size per axis for people: one number when the three agree.
+pub(crate) fn triple(v: [f64; 3]) -> String {
+    if v[0] == v[1] && v[1] == v[2] {
+        human(v[0], 3)
+    } else {
+        v.map(|x| human(x, 3)).join("×")
+    }
+}
+
+/// The summary's lines on the part written: mesh, bounds, pieces, CGAL, time, file.
+pub(crate) fn print_part(r: &PartReport) {
+    outln!(
+        "mesh      {} triangles, {} vertices, area {:.2} mm², volume {:.2} mm³",
+        r.triangles,
+        r.vertices,
+        r.area,
+        r.volume.unwrap_or(f64::NAN)
+    );
+    if let Some(b) = r.bounding_box {
+        outln!(
+            "bounds    [{:.3}, {:.3}, {:.3}] – [{:.3}, {:.3}, {:.3}] mm",
+            b.min[0],
+            b.min[1],
+            b.min[2],
+            b.max[0],
+            b.max[1],
+            b.max[2]
+        );
+    }
+    let f = &r.fragments;
+    let plural = if f.count == 1 { "" } else { "s" };
+    outln!(
+        "pieces    {}",
+        match r.one_piece {
+            None => "not checked (meshed in tiles without a template of its cells)".to_string(),
+            Some(true) if f.count == 0 => "one".to_string(),
+            Some(true) => format!(
+                "one ({} fragment{plural} cut loose by the box removed, {:.3} mm³)",
+                f.count, f.volume
+            ),
+            Some(false) => format!(
+                "{} ({} fragment{plural} kept, {:.3} mm³)",
+                f.count + 1,
+                f.count,
+                f.volume
+            ),
+        }
+    );
+    outln!("CGAL      {}", cgal_findings(&r.checks));
+    let t = &r.timings;
+    outln!(
+        "time      {:.3} s (calibrate {:.3}, sample {:.3}, mesh {:.3}, snap {:.3}, verify {:.3}, write {:.3})",
+        t.total, t.calibrate, t.sample, t.mesh, t.snap, t.verify, t.write
+    );
+    if let Some(o) = &r.output {
+        outln!("wrote     {o}");
+    }
+}

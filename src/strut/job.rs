@@ -1,0 +1,343 @@
+//! One strut-lattice job, start to finish: check the request against what the cell allows
+//! (struts at least [`MIN_STRUT_VOXELS`] across, pores that stay open), find the strut radius
+//! that gives *this* part its density (or take the radius given), raising the resolution when
+//! the struts are too thin for the voxels, mesh, verify, write and report — the meshing is
+//! [`crate::mesh::pipeline`]'s, the resolution search [`crate::mesh::resolution`]'s.
+
+use super::{RadiusModel, StrutFamily, StrutLattice, UnitCell};
+use crate::check::Verdict;
+use crate::error::{Error, Result};
+use crate::field::Domain;
+use crate::io::sink::{MeshCollector, MeshSink};
+use crate::mesh::pipeline::{self, Family, Measured, MeshingStats, Options, Route};
+use crate::mesh::report::{LevelSearch, PartReport, Timings};
+use crate::mesh::resolution::{self, max_resolution};
+use crate::mesh::Mesh;
+use crate::progress::Progress;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Struts thinner than this many voxels across are not represented faithfully by a narrow
+/// band: stretches of the strut hold no sample inside it, and it breaks (an octet truss at 1.6
+/// voxels across falls into thousands of pieces; at 1.8 and up every built-in cell stays
+/// whole). The resolution is raised to keep struts this thick.
+pub const MIN_STRUT_VOXELS: f64 = 2.0;
+
+/// How thick the struts are: made to a volume fraction, or given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Sizing {
+    /// The radius that gives the written part this volume fraction, in (0, 1).
+    Density(f64),
+    /// This radius, mm.
+    Radius(f64),
+}
+
+/// What to build.
+#[derive(Debug, Clone)]
+pub struct StrutJob {
+    /// The unit cell.
+    pub cell: Arc<UnitCell>,
+    /// Its name, for messages and the report (a built-in name or the cell file).
+    pub cell_name: String,
+    /// Density or radius.
+    pub sizing: Sizing,
+    /// Radius of the smooth minimum at the joints, mm (0: a sharp union).
+    pub blend: f64,
+    /// The box: cell size, overall size and lower corner, mm.
+    pub domain: Domain,
+    /// Voxels per cell along the cell's shortest axis.
+    pub resolution: u32,
+    /// Raise the resolution when struts would be thinner than [`MIN_STRUT_VOXELS`] or no
+    /// radius on these voxels gives the density.
+    pub auto_resolution: bool,
+    /// The pipeline's options.
+    pub options: Options,
+}
+
+/// The radii (and densities) a cell can be built at.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct StrutRange {
+    /// The thinnest struts, at [`MIN_STRUT_VOXELS`] across at the resolution used, mm.
+    pub min_radius: f64,
+    /// The radius at which the pores close, mm.
+    pub max_radius: f64,
+    /// The cell's volume fraction at `min_radius` (the radius model's).
+    pub min_density: f64,
+    /// The cell's volume fraction at `max_radius` (the radius model's).
+    pub max_density: f64,
+}
+
+/// The JSON report of a strut job.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct StrutReport {
+    /// The unit cell: a built-in name or the cell file.
+    pub cell: String,
+    /// Nodes and struts of one period of the cell (each strut once).
+    pub cell_nodes: usize,
+    /// Struts of one period of the cell.
+    pub cell_struts: usize,
+    /// The strut radius written, mm (times each node's factor).
+    pub radius: f64,
+    /// Radius of the smooth minimum at the joints, mm.
+    pub blend: f64,
+    /// Thinnest strut, voxels across.
+    pub thinnest_strut_voxels: f64,
+    /// What the cell allows.
+    pub feasible_range: StrutRange,
+    /// How the radius was found (its levels are radii).
+    pub level_search: LevelSearch,
+    /// Voxels per cell asked for.
+    pub resolution_requested: u32,
+    /// Voxels per cell used.
+    pub resolution: u32,
+    /// Voxel edge, mm.
+    pub voxel_size: f64,
+    /// Cell size per axis, mm.
+    pub cell_size: [f64; 3],
+    /// Cells per axis (fractional where the box ends inside a cell).
+    pub cells: [f64; 3],
+    /// The part as written: density, mesh, checks, timings, warnings.
+    #[serde(flatten)]
+    pub part: PartReport,
+}
+
+impl StrutReport {
+    /// The part's verdict.
+    pub fn verdict(&self) -> Verdict {
+        self.part.verdict()
+    }
+}
+
+/// A resolution at which the part was found: its voxel, route and the part measured.
+struct Found {
+    voxel: f64,
+    route: Route,
+    best: Measured,
+    tried: Vec<(f64, f64)>,
+    meshing: MeshingStats,
+}
+
+impl StrutJob {
+    fn validate(&self) -> Result<()> {
+        match self.sizing {
+            Sizing::Density(d) if !(d > 0.0 && d < 1.0) => {
+                return Err(Error::invalid(format!(
+                    "density must be in (0, 1), got {d}"
+                )))
+            }
+            Sizing::Radius(r) if !(r > 0.0 && r.is_finite()) => {
+                return Err(Error::invalid(format!(
+                    "radius must be a positive length in mm, got {r}"
+                )))
+            }
+            _ => {}
+        }
+        if !(self.blend >= 0.0 && self.blend.is_finite()) {
+            return Err(Error::invalid(format!(
+                "blend must be a length ≥ 0 mm, got {}",
+                self.blend
+            )));
+        }
+        if self.resolution < 4 {
+            return Err(Error::invalid(format!(
+                "resolution must be at least 4 voxels per cell, got {}",
+                self.resolution
+            )));
+        }
+        Ok(())
+    }
+
+    /// Runs the job and returns the mesh with its report.
+    pub fn run(&self, progress: &Progress) -> Result<(Mesh, StrutReport)> {
+        let mut collector = MeshCollector::default();
+        let report = self.run_into(progress, &mut collector)?;
+        Ok((collector.mesh, report))
+    }
+
+    /// The voxel edge at `resolution` voxels per cell, mm.
+    fn voxel(&self, resolution: u32) -> f64 {
+        let c = self.domain.cell;
+        c[0].min(c[1]).min(c[2]) / resolution as f64
+    }
+
+    /// The smallest radius factor: the thinnest strut is the radius times it.
+    fn thinnest_factor(&self) -> f64 {
+        self.cell
+            .radii
+            .iter()
+            .cloned()
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The radii and densities the cell allows at `resolution`.
+    fn range(&self, model: &RadiusModel, resolution: u32) -> StrutRange {
+        let min_radius = 0.5 * MIN_STRUT_VOXELS * self.voxel(resolution) / self.thinnest_factor();
+        StrutRange {
+            min_radius,
+            max_radius: model.closing,
+            min_density: model.fraction(min_radius),
+            max_density: model.fraction(model.closing),
+        }
+    }
+
+    /// Runs the job, streaming the part's triangles into `sink`.
+    pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<StrutReport> {
+        let start = Instant::now();
+        self.validate()?;
+        let model_start = Instant::now();
+        let bounds = self.domain.bounds();
+        let family = StrutFamily::new(StrutLattice {
+            cell: self.cell.clone(),
+            size: self.domain.cell,
+            radius: 0.0,
+            blend: self.blend,
+            bounds,
+            phase: bounds.min,
+        });
+        let model_seconds = model_start.elapsed().as_secs_f64();
+        let r0 = match self.sizing {
+            Sizing::Density(d) => family.model_level(d),
+            Sizing::Radius(r) => r,
+        };
+        let thin = self.thin_struts(r0)?;
+        self.refuse_closed(&family.model, r0)?;
+        let target = match self.sizing {
+            Sizing::Density(d) => Some(d),
+            Sizing::Radius(_) => None,
+        };
+        let request = resolution::Request {
+            part: format!("the {} lattice", self.cell_name),
+            setting: self.setting(),
+            requested: self.resolution,
+            thin,
+            density: target,
+            auto: self.auto_resolution,
+        };
+        let opts = &self.options;
+        let resolved = resolution::search(&request, &mut |r| {
+            let _p = progress.stage(if r == self.resolution {
+                "finding the strut radius"
+            } else {
+                "searching for a resolution that reaches the density"
+            });
+            let voxel = self.voxel(r);
+            let route = Route::choose(&family.at(r0), voxel, opts);
+            Ok(match target {
+                Some(d) => {
+                    let solved = pipeline::solve(&family, d, r0, voxel, route, opts)?;
+                    if solved.met {
+                        Ok(Found {
+                            voxel,
+                            route,
+                            best: solved.best,
+                            tried: solved.tried,
+                            meshing: solved.meshing,
+                        })
+                    } else {
+                        Err(solved.best.fraction)
+                    }
+                }
+                None => {
+                    let best = pipeline::measure(&family, r0, voxel, route, opts)?;
+                    Ok(Found {
+                        voxel,
+                        route,
+                        tried: vec![(r0, best.fraction)],
+                        meshing: best.meshing,
+                        best,
+                    })
+                }
+            })
+        })?;
+        let Found {
+            voxel,
+            route,
+            best,
+            tried,
+            meshing,
+        } = resolved.found;
+        let radius = best.level;
+        let level_search = LevelSearch::new(&best, route, &tried, resolved.coarser);
+        let written = pipeline::write(&family, best, voxel, route, opts, progress, sink)?;
+        let mut part = PartReport::new(
+            bounds,
+            target,
+            route,
+            written,
+            meshing,
+            Timings {
+                calibrate: model_seconds,
+                ..Timings::default()
+            },
+        );
+        let mut warnings: Vec<String> = resolved.raised.into_iter().collect();
+        warnings.append(&mut part.warnings);
+        part.warnings = warnings;
+        part.timings.total = start.elapsed().as_secs_f64();
+        Ok(StrutReport {
+            cell: self.cell_name.clone(),
+            cell_nodes: self.cell.nodes.len(),
+            cell_struts: self.cell.struts.len(),
+            radius,
+            blend: self.blend,
+            thinnest_strut_voxels: 2.0 * radius * self.thinnest_factor() / voxel,
+            feasible_range: self.range(&family.model, resolved.resolution),
+            level_search,
+            resolution_requested: self.resolution,
+            resolution: resolved.resolution,
+            voxel_size: voxel,
+            cell_size: self.domain.cell,
+            cells: self.domain.counts(),
+            part,
+        })
+    }
+
+    /// The resolution struts of radius `r` need, when the requested one leaves them thinner
+    /// than [`MIN_STRUT_VOXELS`], and why; refused when even the finest resolution searched
+    /// would not do.
+    fn thin_struts(&self, r: f64) -> Result<Option<(u32, String)>> {
+        let req = self.resolution;
+        let across = 2.0 * r * self.thinnest_factor() / self.voxel(req);
+        if across >= MIN_STRUT_VOXELS {
+            return Ok(None);
+        }
+        let needed = (req as f64 * MIN_STRUT_VOXELS / across).ceil() as u32;
+        let why = format!("struts were {across:.2} voxels across at {req} voxels per cell");
+        if self.auto_resolution && needed > max_resolution(req) {
+            return Err(Error::invalid(format!(
+                "the {} lattice at {}: {why}, and would need {needed} voxels per cell; give a larger radius or density (at {req} voxels per cell: radius ≥ {:.4} mm), or --resolution {needed}",
+                self.cell_name,
+                self.setting(),
+                0.5 * MIN_STRUT_VOXELS * self.voxel(req) / self.thinnest_factor(),
+            )));
+        }
+        Ok(Some((needed, why)))
+    }
+
+    /// Refuses a radius at which the pores close: the void no longer runs through the lattice.
+    fn refuse_closed(&self, model: &RadiusModel, r: f64) -> Result<()> {
+        if r < model.closing {
+            return Ok(());
+        }
+        let range = self.range(model, self.resolution);
+        Err(Error::invalid(format!(
+            "the {} lattice at {} closes up: its pores close at radius {:.4} mm (density {:.3}), trapping powder or resin; it can be built at radius {:.4} to {:.4} mm, density {:.3} to {:.3} (at {} voxels per cell)",
+            self.cell_name,
+            self.setting(),
+            range.max_radius,
+            range.max_density,
+            range.min_radius,
+            range.max_radius,
+            range.min_density,
+            range.max_density,
+            self.resolution
+        )))
+    }
+
+    fn setting(&self) -> String {
+        match self.sizing {
+            Sizing::Density(d) => format!("density {d}"),
+            Sizing::Radius(r) => format!("radius {r} mm"),
+        }
+    }
+}
