@@ -8,9 +8,13 @@ use common::*;
 use std::f64::consts::PI;
 use std::path::Path;
 
-/// Runs `latvox strut` with `args` in `dir`, writing `part.stl` and `part.json`.
+/// Runs `latvox strut` with `args` in `dir`, writing `part.json` and `part.stl` (unless `args`
+/// name the output).
 fn strut(dir: &Path, args: &[&str]) -> std::process::Output {
-    let mut all = vec!["strut", "-q", "-o", "part.stl", "--report", "part.json"];
+    let mut all = vec!["strut", "-q", "--report", "part.json"];
+    if !args.contains(&"-o") {
+        all.extend_from_slice(&["-o", "part.stl"]);
+    }
     all.extend_from_slice(args);
     run(&all, dir)
 }
@@ -339,4 +343,113 @@ fn random_settings_meet_their_density_or_are_refused() {
     }
     // The settings are drawn where the cells can be built: most must be.
     assert!(built >= 10, "{built} built, {refused} refused");
+}
+
+/// Reads a 3MF with lib3mf (the 3MF Consortium's reference library, from PyPI): per mesh
+/// object, its name, triangles, beams, clipping mode and the distinct beam radii.
+fn lib3mf_read(path: &Path) -> serde_json::Value {
+    const SCRIPT: &str = r#"
+import json, sys, lib3mf
+w = lib3mf.get_wrapper()
+m = w.CreateModel()
+m.QueryReader("3mf").ReadFromFile(sys.argv[1])
+out = []
+it = m.GetMeshObjects()
+while it.MoveNext():
+    o = it.GetCurrentMeshObject()
+    bl = o.BeamLattice()
+    radii = set()
+    caps = set()
+    for i in range(bl.GetBeamCount()):
+        b = bl.GetBeam(i)
+        radii.update(round(r, 9) for r in b.Radii)
+        caps.update(int(c) for c in b.CapModes)
+    out.append({"name": o.GetName(), "triangles": o.GetTriangleCount(),
+                "beams": bl.GetBeamCount(), "clipping": int(bl.GetClipping()[0]),
+                "sets": bl.GetBeamSetCount(), "radii": sorted(radii), "caps": sorted(caps)})
+print(json.dumps(out))
+"#;
+    let o = std::process::Command::new("python3")
+        .args(["-c", SCRIPT])
+        .arg(path)
+        .output()
+        .expect("python3 with lib3mf (scripts/install-deps.sh installs it)");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+#[test]
+fn beams_are_read_back_by_lib3mf_as_written() {
+    let dir = tempdir();
+    let d = dir.path();
+    // Simple cubic, 3×3×3 whole cells: (N + 1)² lines of nodes per axis, each with N beams
+    // inside and one poking in at each end (clipped by the box): 3 · 16 · 5 beams.
+    let out = run(
+        &[
+            "strut", "-q", "--cell", "sc", "--radius", "0.5", "--cells", "3", "--beams", "-o",
+            "sc.3mf", "--report", "sc.json",
+        ],
+        d,
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let objects = lib3mf_read(&d.join("sc.3mf"));
+    let lattice = &objects[1];
+    assert_eq!(lattice["beams"], 240);
+    assert_eq!(lattice["triangles"], 0);
+    assert_eq!(lattice["radii"], serde_json::json!([0.5]));
+    // Sphere caps (capsules); clipped inside the box, which is the other object.
+    assert_eq!(lattice["caps"], serde_json::json!([0]));
+    assert_eq!(lattice["clipping"], 1);
+    assert_eq!(objects[0]["triangles"], 12);
+    assert_eq!(json(&d.join("sc.json"))["beams"], 240);
+
+    // An octet truss to a density: the beams carry the radius found on the meshed part (lib3mf
+    // holds radii in single precision).
+    let out = run(
+        &[
+            "strut",
+            "-q",
+            "--cell",
+            "octet",
+            "--density",
+            "0.2",
+            "--cells",
+            "4",
+            "--beams",
+            "-o",
+            "octet.3mf",
+            "--report",
+            "octet.json",
+        ],
+        d,
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rep = json(&d.join("octet.json"));
+    assert!((rep["meshed_density"].as_f64().unwrap() - 0.2).abs() <= 0.002);
+    let lattice = &lib3mf_read(&d.join("octet.3mf"))[1];
+    assert_eq!(lattice["beams"], rep["beams"]);
+    let r = rep["radius"].as_f64().unwrap();
+    let radii: Vec<f64> = serde_json::from_value(lattice["radii"].clone()).unwrap();
+    assert!(
+        radii.len() == 1 && (radii[0] - r).abs() < 1e-6 * r,
+        "{radii:?} vs {r}"
+    );
+    assert_eq!(lattice["sets"], 24);
+
+    for (args, what) in [
+        (&["--beams"][..], "3MF"),
+        (&["--beams", "--blend", "0.2", "-o", "b.3mf"], "blend"),
+    ] {
+        assert_refused(d, args, what);
+    }
 }

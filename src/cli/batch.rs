@@ -136,8 +136,7 @@ impl Task for StrutArgs {
     }
 
     fn run(&self) -> Result<TaskReport> {
-        let r = super::strut::execute(self, &Progress::hidden())?;
-        TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
+        super::strut::execute(self, &Progress::hidden())?.task_report()
     }
 }
 

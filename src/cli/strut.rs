@@ -2,11 +2,11 @@
 
 use super::lattice::{human, print_part, triple, BoxArgs, MeshArgs};
 use super::out::outln;
-use super::{parse_density, parse_length0, parse_positive};
+use super::{parse_density, parse_length0, parse_positive, write_json};
 use clap::Args;
 use latvox::strut::cell::BUILT_IN;
-use latvox::strut::{Sizing, StrutJob, StrutReport, UnitCell};
-use latvox::Result;
+use latvox::strut::{BeamsReport, Sizing, StrutJob, StrutReport, UnitCell};
+use latvox::{Error, Result};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -23,6 +23,9 @@ Examples:
   # radius factor per node (struts between nodes of different factors are tapered)
   echo '{\"nodes\": [[0,0,0],[1,1,1],[1,0,0]], \"struts\": [[0,1],[0,2]], \"radii\": [1.5,1,1]}' > cell.json
   latvox strut --cell cell.json --density 0.15 --cells 5 --cell-size 4 -o custom.stl
+
+  # The same lattice as 3MF beams (each strut a beam, the box a clipping mesh): kilobytes
+  latvox strut --cell octet --density 0.2 --cells 10 --cell-size 5 --beams -o octet-beams.3mf
 
   # 30×30×30 cells: copies of a meshed template streamed to the file, memory flat
   latvox strut --cell kelvin --density 0.1 --cells 30 --cell-size 3 --resolution 16 -o big.stl
@@ -52,6 +55,11 @@ pub struct StrutArgs {
     /// Fillet the joints: smooth minimum over this many mm (0: a sharp union).
     #[arg(long, value_name = "MM", default_value_t = 0.0, value_parser = parse_length0, allow_hyphen_values = true)]
     pub blend: f64,
+    /// Write the lattice as beams (3MF Beam Lattice extension: each strut a beam with its
+    /// radii, the box a clipping mesh) instead of a mesh: kilobytes instead of gigabytes, for
+    /// printers and tools that read beams. The output must be .3mf; joints cannot be blended.
+    #[arg(long)]
+    pub beams: bool,
     /// The box of cells.
     #[command(flatten)]
     pub domain: BoxArgs,
@@ -95,20 +103,91 @@ impl StrutArgs {
     }
 }
 
-pub fn run(a: &StrutArgs, quiet: bool) -> Result<i32> {
-    a.mesh.check_report()?;
-    let report = execute(a, &latvox::progress::Progress::new(quiet))?;
-    let code = a.mesh.finish(&report, &report.part)?;
-    print_summary(&report);
-    Ok(code)
+/// What a strut run made: a meshed part, or beams.
+pub enum Made {
+    /// The part as a mesh.
+    Mesh(StrutReport),
+    /// The lattice as 3MF beams.
+    Beams(BeamsReport),
 }
 
-/// Runs the job and writes its mesh atomically; returns the report, for `run` to print and
-/// `latvox batch` to record.
-pub fn execute(a: &StrutArgs, progress: &latvox::progress::Progress) -> Result<StrutReport> {
+impl Made {
+    /// The report, its verdict and its warnings, for `latvox batch`.
+    pub fn task_report(&self) -> Result<latvox::batch::TaskReport> {
+        match self {
+            Made::Mesh(r) => {
+                latvox::batch::TaskReport::new(r, &r.verdict(), r.part.warnings.clone())
+            }
+            Made::Beams(r) => latvox::batch::TaskReport::new(r, &r.verdict(), Vec::new()),
+        }
+    }
+}
+
+pub fn run(a: &StrutArgs, quiet: bool) -> Result<i32> {
+    a.mesh.check_report()?;
+    match execute(a, &latvox::progress::Progress::new(quiet))? {
+        Made::Mesh(report) => {
+            let code = a.mesh.finish(&report, &report.part)?;
+            print_summary(&report);
+            Ok(code)
+        }
+        Made::Beams(report) => {
+            if let Some(r) = &a.mesh.report {
+                write_json(r, &report)?;
+            }
+            print_beams_summary(&report);
+            Ok(report.verdict().exit_code())
+        }
+    }
+}
+
+/// Runs the job and writes its mesh (or beams) atomically; returns the report, for `run` to
+/// print and `latvox batch` to record.
+pub fn execute(a: &StrutArgs, progress: &latvox::progress::Progress) -> Result<Made> {
     let job = a.job()?;
-    a.mesh
-        .write(|sink| job.run_into(progress, sink), |r| &mut r.part)
+    if !a.beams {
+        return Ok(Made::Mesh(
+            a.mesh
+                .write(|sink| job.run_into(progress, sink), |r| &mut r.part)?,
+        ));
+    }
+    let out = &a.mesh.output;
+    let is_3mf = out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("3mf"));
+    if !is_3mf {
+        return Err(Error::invalid(format!(
+            "{}: beams are written to 3MF only: name the output .3mf",
+            out.display()
+        )));
+    }
+    latvox::io::atomic::check_writable(out)?;
+    let (model, mut report) = job.beams(progress)?;
+    latvox::io::atomic::write_atomic(out, |w| latvox::io::threemf::write_beams(&model, w))?;
+    report.output = Some(out.display().to_string());
+    Ok(Made::Beams(report))
+}
+
+fn print_beams_summary(r: &BeamsReport) {
+    let cells = r.cells.map(|x| human(x, 2)).join("×");
+    outln!(
+        "{} beams · {cells} cells of {} mm",
+        r.cell,
+        triple(r.cell_size)
+    );
+    outln!(
+        "beams     {} beams of radius {:.4} mm between {} vertices, clipped by the box",
+        r.beams,
+        r.radius,
+        r.vertices
+    );
+    if let (Some(t), Some(f), Some(res)) = (r.target_density, r.meshed_density, r.resolution) {
+        outln!("density   target {t:.4}  meshed at this radius {f:.4}  ({res} voxels per cell)");
+    }
+    outln!("time      {:.3} s", r.seconds);
+    if let Some(o) = &r.output {
+        outln!("wrote     {o}");
+    }
 }
 
 fn print_summary(r: &StrutReport) {

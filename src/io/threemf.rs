@@ -356,6 +356,139 @@ pub fn write(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
     w.write_all(&buf)
 }
 
+const BEAM_NS: &str = "http://schemas.microsoft.com/3dmanufacturing/beamlattice/2017/02";
+
+/// A lattice of beams for the 3MF Beam Lattice extension (v1.2): vertices, beams between them
+/// with a radius at each end (capped by spheres: capsules, or cones with rounded ends), grouped
+/// in named sets, clipped by a box (a clipping mesh, `clippingmode="inside"`).
+#[derive(Debug, Clone, Default)]
+pub struct BeamModel {
+    /// Vertex positions, mm.
+    pub vertices: Vec<[f64; 3]>,
+    /// Beams: vertex indices and the radius at each end, mm.
+    pub beams: Vec<([u32; 2], [f64; 2])>,
+    /// The lattice's default radius, mm.
+    pub radius: f64,
+    /// Beams shorter than this are not written (the extension's `minlength`), mm.
+    pub min_length: f64,
+    /// The box that clips the beams, if any.
+    pub clip: Option<crate::field::Aabb>,
+    /// Per beam, the index of its set in `set_names`.
+    pub sets: Vec<u32>,
+    /// The names of the beam sets.
+    pub set_names: Vec<String>,
+}
+
+/// Writes `m` as a 3MF package: a lattice-only mesh object (no triangles) holding the beams,
+/// and, when the beams are clipped, the box as a mesh object it names as its clipping mesh.
+pub fn write_beams(m: &BeamModel, w: &mut dyn Write) -> std::io::Result<()> {
+    let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
+    let opts = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    let z = |e: zip::result::ZipError| std::io::Error::other(e);
+    zip.start_file("[Content_Types].xml", opts).map_err(z)?;
+    zip.write_all(CONTENT_TYPES)?;
+    zip.start_file("_rels/.rels", opts).map_err(z)?;
+    zip.write_all(rels().as_bytes())?;
+    zip.start_file("3D/3dmodel.model", opts).map_err(z)?;
+    {
+        let mut x = std::io::BufWriter::with_capacity(1 << 16, &mut zip);
+        write!(
+            x,
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" xml:lang=\"en-US\" xmlns=\"{MODEL_NS}\" xmlns:b=\"{BEAM_NS}\" requiredextensions=\"b\">\n<metadata name=\"Application\">latvox</metadata>\n<resources>\n"
+        )?;
+        let lattice_id = if let Some(b) = m.clip {
+            x.write_all(
+                b"<object id=\"1\" type=\"model\" name=\"clipping box\">\n<mesh>\n<vertices>\n",
+            )?;
+            for i in 0..8 {
+                let c = [i & 1, (i >> 1) & 1, (i >> 2) & 1];
+                let p = [0, 1, 2].map(|a| if c[a] == 1 { b.max[a] } else { b.min[a] });
+                writeln!(x, "<vertex x=\"{}\" y=\"{}\" z=\"{}\"/>", p[0], p[1], p[2])?;
+            }
+            x.write_all(b"</vertices>\n<triangles>\n")?;
+            // The cube's faces, wound outward (corner i has bits x, y, z).
+            for t in [
+                [0, 2, 3],
+                [0, 3, 1],
+                [4, 5, 7],
+                [4, 7, 6],
+                [0, 1, 5],
+                [0, 5, 4],
+                [2, 6, 7],
+                [2, 7, 3],
+                [0, 4, 6],
+                [0, 6, 2],
+                [1, 3, 7],
+                [1, 7, 5],
+            ] {
+                triangle_line(&mut x, &t)?;
+            }
+            x.write_all(b"</triangles>\n</mesh>\n</object>\n")?;
+            2
+        } else {
+            1
+        };
+        writeln!(
+            x,
+            "<object id=\"{lattice_id}\" type=\"model\" name=\"lattice\">\n<mesh>\n<vertices>"
+        )?;
+        for p in &m.vertices {
+            writeln!(x, "<vertex x=\"{}\" y=\"{}\" z=\"{}\"/>", p[0], p[1], p[2])?;
+        }
+        write!(
+            x,
+            "</vertices>\n<b:beamlattice minlength=\"{}\" radius=\"{}\" cap=\"sphere\"",
+            m.min_length, m.radius
+        )?;
+        if m.clip.is_some() {
+            x.write_all(b" clippingmode=\"inside\" clippingmesh=\"1\"")?;
+        }
+        x.write_all(b">\n<b:beams>\n")?;
+        let mut kept = Vec::with_capacity(m.beams.len());
+        for (i, ([a, b], [ra, rb])) in m.beams.iter().enumerate() {
+            let (p, q) = (m.vertices[*a as usize], m.vertices[*b as usize]);
+            let len = (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>().sqrt();
+            if a == b || len < m.min_length {
+                continue;
+            }
+            writeln!(x, "<b:beam v1=\"{a}\" v2=\"{b}\" r1=\"{ra}\" r2=\"{rb}\"/>")?;
+            kept.push(i);
+        }
+        x.write_all(b"</b:beams>\n")?;
+        if !m.set_names.is_empty() && m.sets.len() == m.beams.len() {
+            let mut members: Vec<Vec<usize>> = vec![Vec::new(); m.set_names.len()];
+            for (index, &i) in kept.iter().enumerate() {
+                members[m.sets[i] as usize].push(index);
+            }
+            x.write_all(b"<b:beamsets>\n")?;
+            for (name, refs) in m.set_names.iter().zip(&members) {
+                writeln!(x, "<b:beamset name=\"{}\">", xml_escape(name))?;
+                for r in refs {
+                    writeln!(x, "<b:ref index=\"{r}\"/>")?;
+                }
+                x.write_all(b"</b:beamset>\n")?;
+            }
+            x.write_all(b"</b:beamsets>\n")?;
+        }
+        writeln!(
+            x,
+            "</b:beamlattice>\n</mesh>\n</object>\n</resources>\n<build>\n<item objectid=\"{lattice_id}\"/>\n</build>\n</model>"
+        )?;
+        x.flush()?;
+    }
+    let buf = zip.finish().map_err(z)?.into_inner();
+    w.write_all(&buf)
+}
+
+/// `s` with XML's special characters escaped, for an attribute.
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

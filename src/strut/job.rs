@@ -7,11 +7,12 @@
 use super::{RadiusModel, StrutFamily, StrutLattice, UnitCell};
 use crate::check::Verdict;
 use crate::error::{Error, Result};
-use crate::field::Domain;
+use crate::field::{Aabb, Domain};
 use crate::io::sink::{MeshCollector, MeshSink};
+use crate::io::threemf::BeamModel;
 use crate::mesh::pipeline::{self, Family, Measured, MeshingStats, Options, Route};
 use crate::mesh::report::{LevelSearch, PartReport, Timings};
-use crate::mesh::resolution::{self, max_resolution};
+use crate::mesh::resolution::{self, max_resolution, Resolved};
 use crate::mesh::Mesh;
 use crate::progress::Progress;
 use std::sync::Arc;
@@ -108,6 +109,60 @@ impl StrutReport {
     }
 }
 
+/// The JSON report of a strut job written as beams.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct BeamsReport {
+    /// The unit cell: a built-in name or the cell file.
+    pub cell: String,
+    /// The beams' radius, mm (times each node's factor).
+    pub radius: f64,
+    /// The volume fraction asked for (`null` when the radius was given).
+    pub target_density: Option<f64>,
+    /// The volume fraction of the part meshed at this radius, which the radius was found on
+    /// (`null` when the radius was given).
+    pub meshed_density: Option<f64>,
+    /// Voxels per cell of that meshing.
+    pub resolution: Option<u32>,
+    /// Beams written.
+    pub beams: u64,
+    /// Vertices the beams join.
+    pub vertices: u64,
+    /// What clips the beams: the box, as a clipping mesh.
+    pub clipped_by: &'static str,
+    /// The part's box, mm.
+    #[serde(rename = "box")]
+    pub bounds: Aabb,
+    /// Cell size per axis, mm.
+    pub cell_size: [f64; 3],
+    /// Cells per axis (fractional where the box ends inside a cell).
+    pub cells: [f64; 3],
+    /// Wall time, seconds.
+    pub seconds: f64,
+    /// The output file, when the command line wrote one.
+    pub output: Option<String>,
+}
+
+impl BeamsReport {
+    /// The beams' verdict: no surface to check (the beams are capsules by definition), so only
+    /// whether the meshed part the radius was found on met its density.
+    pub fn verdict(&self) -> Verdict {
+        Verdict {
+            closed: true,
+            manifold: true,
+            outward: true,
+            self_intersection_checked: false,
+            self_intersecting: false,
+            sound_facets: true,
+            one_piece: None,
+            density_met: self
+                .target_density
+                .zip(self.meshed_density)
+                .map(|(t, f)| (f - t).abs() <= pipeline::PROMISE),
+            features_printable: None,
+        }
+    }
+}
+
 /// A resolution at which the part was found: its voxel, route and the part measured.
 struct Found {
     voxel: f64,
@@ -180,11 +235,9 @@ impl StrutJob {
         }
     }
 
-    /// Runs the job, streaming the part's triangles into `sink`.
-    pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<StrutReport> {
-        let start = Instant::now();
-        self.validate()?;
-        let model_start = Instant::now();
+    /// The lattice's family of radii, its model measured (and the seconds that took).
+    fn family(&self) -> (StrutFamily, f64) {
+        let t = Instant::now();
         let bounds = self.domain.bounds();
         let family = StrutFamily::new(StrutLattice {
             cell: self.cell.clone(),
@@ -194,17 +247,27 @@ impl StrutJob {
             bounds,
             phase: bounds.min,
         });
-        let model_seconds = model_start.elapsed().as_secs_f64();
+        (family, t.elapsed().as_secs_f64())
+    }
+
+    /// The target density, when the struts are made to one.
+    fn target(&self) -> Option<f64> {
+        match self.sizing {
+            Sizing::Density(d) => Some(d),
+            Sizing::Radius(_) => None,
+        }
+    }
+
+    /// Finds the resolution and radius of the part: the radius given, or the one at which the
+    /// part (or a template of its cells) meshes to the target density.
+    fn search(&self, family: &StrutFamily, progress: &Progress) -> Result<Resolved<Found>> {
         let r0 = match self.sizing {
             Sizing::Density(d) => family.model_level(d),
             Sizing::Radius(r) => r,
         };
         let thin = self.thin_struts(r0)?;
         self.refuse_closed(&family.model, r0)?;
-        let target = match self.sizing {
-            Sizing::Density(d) => Some(d),
-            Sizing::Radius(_) => None,
-        };
+        let target = self.target();
         let request = resolution::Request {
             part: format!("the {} lattice", self.cell_name),
             setting: self.setting(),
@@ -214,7 +277,7 @@ impl StrutJob {
             auto: self.auto_resolution,
         };
         let opts = &self.options;
-        let resolved = resolution::search(&request, &mut |r| {
+        resolution::search(&request, &mut |r| {
             let _p = progress.stage(if r == self.resolution {
                 "finding the strut radius"
             } else {
@@ -224,7 +287,7 @@ impl StrutJob {
             let route = Route::choose(&family.at(r0), voxel, opts);
             Ok(match target {
                 Some(d) => {
-                    let solved = pipeline::solve(&family, d, r0, voxel, route, opts)?;
+                    let solved = pipeline::solve(family, d, r0, voxel, route, opts)?;
                     if solved.met {
                         Ok(Found {
                             voxel,
@@ -238,7 +301,7 @@ impl StrutJob {
                     }
                 }
                 None => {
-                    let best = pipeline::measure(&family, r0, voxel, route, opts)?;
+                    let best = pipeline::measure(family, r0, voxel, route, opts)?;
                     Ok(Found {
                         voxel,
                         route,
@@ -248,7 +311,15 @@ impl StrutJob {
                     })
                 }
             })
-        })?;
+        })
+    }
+
+    /// Runs the job, streaming the part's triangles into `sink`.
+    pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<StrutReport> {
+        let start = Instant::now();
+        self.validate()?;
+        let (family, model_seconds) = self.family();
+        let resolved = self.search(&family, progress)?;
         let Found {
             voxel,
             route,
@@ -258,10 +329,11 @@ impl StrutJob {
         } = resolved.found;
         let radius = best.level;
         let level_search = LevelSearch::new(&best, route, &tried, resolved.coarser);
+        let opts = &self.options;
         let written = pipeline::write(&family, best, voxel, route, opts, progress, sink)?;
         let mut part = PartReport::new(
-            bounds,
-            target,
+            self.domain.bounds(),
+            self.target(),
             route,
             written,
             meshing,
@@ -290,6 +362,51 @@ impl StrutJob {
             cells: self.domain.counts(),
             part,
         })
+    }
+
+    /// The lattice as beams (the 3MF Beam Lattice extension's): the struts of every cell that
+    /// reach into the box, as capsules of the radius given or of the radius at which the meshed
+    /// part has the target density, clipped by the box. Joints cannot be blended in beams.
+    pub fn beams(&self, progress: &Progress) -> Result<(BeamModel, BeamsReport)> {
+        let start = Instant::now();
+        self.validate()?;
+        if self.blend > 0.0 {
+            return Err(Error::invalid(
+                "blended joints cannot be written as beams (3MF beams are capsules and balls): drop --blend, or write a mesh",
+            ));
+        }
+        let (family, _) = self.family();
+        let (radius, measured, resolution) = match self.sizing {
+            Sizing::Radius(r) => {
+                self.refuse_closed(&family.model, r)?;
+                (r, None, None)
+            }
+            Sizing::Density(_) => {
+                let resolved = self.search(&family, progress)?;
+                let best = &resolved.found.best;
+                (best.level, Some(best.fraction), Some(resolved.resolution))
+            }
+        };
+        let model = {
+            let _p = progress.stage("listing the beams");
+            super::beams::beams(&family.at(radius))
+        };
+        let report = BeamsReport {
+            cell: self.cell_name.clone(),
+            radius,
+            target_density: self.target(),
+            meshed_density: measured,
+            resolution,
+            beams: model.beams.len() as u64,
+            vertices: model.vertices.len() as u64,
+            clipped_by: "box",
+            bounds: self.domain.bounds(),
+            cell_size: self.domain.cell,
+            cells: self.domain.counts(),
+            seconds: start.elapsed().as_secs_f64(),
+            output: None,
+        };
+        Ok((model, report))
     }
 
     /// The resolution struts of radius `r` need, when the requested one leaves them thinner

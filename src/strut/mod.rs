@@ -1,7 +1,9 @@
 //! Strut (beam) lattices: unit cells of struts ([`cell`]) and the lattice as a periodic field
 //! evaluated in one cell ([`field`]), the part at every radius for the meshing pipeline
-//! ([`lattice`]) and the job that makes a part to a density or radius ([`job`]).
+//! ([`lattice`]), the lattice as beams for 3MF ([`beams`]) and the job that makes a part to a
+//! density or radius ([`job`]).
 
+pub mod beams;
 pub mod cell;
 pub mod field;
 pub mod job;
@@ -9,5 +11,5 @@ pub mod lattice;
 
 pub use cell::UnitCell;
 pub use field::StrutField;
-pub use job::{Sizing, StrutJob, StrutReport};
+pub use job::{BeamsReport, Sizing, StrutJob, StrutReport};
 pub use lattice::{RadiusModel, StrutFamily, StrutLattice};
