@@ -106,9 +106,9 @@ impl StrutArgs {
 /// What a strut run made: a meshed part, or beams.
 pub enum Made {
     /// The part as a mesh.
-    Mesh(StrutReport),
+    Mesh(Box<StrutReport>),
     /// The lattice as 3MF beams.
-    Beams(BeamsReport),
+    Beams(Box<BeamsReport>),
 }
 
 impl Made {
@@ -146,10 +146,10 @@ pub fn run(a: &StrutArgs, quiet: bool) -> Result<i32> {
 pub fn execute(a: &StrutArgs, progress: &latvox::progress::Progress) -> Result<Made> {
     let job = a.job()?;
     if !a.beams {
-        return Ok(Made::Mesh(
-            a.mesh
-                .write(|sink| job.run_into(progress, sink), |r| &mut r.part)?,
-        ));
+        let report = a
+            .mesh
+            .write(|sink| job.run_into(progress, sink), |r| &mut r.part)?;
+        return Ok(Made::Mesh(Box::new(report)));
     }
     let out = &a.mesh.output;
     let is_3mf = out
@@ -165,7 +165,7 @@ pub fn execute(a: &StrutArgs, progress: &latvox::progress::Progress) -> Result<M
     let (model, mut report) = job.beams(progress)?;
     latvox::io::atomic::write_atomic(out, |w| latvox::io::threemf::write_beams(&model, w))?;
     report.output = Some(out.display().to_string());
-    Ok(Made::Beams(report))
+    Ok(Made::Beams(Box::new(report)))
 }
 
 fn print_beams_summary(r: &BeamsReport) {

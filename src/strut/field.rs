@@ -330,13 +330,22 @@ mod tests {
     /// middle cells to a strut of a cell outside the block.
     #[test]
     fn one_cell_with_augmentation_is_the_whole_lattice() {
-        let custom = UnitCell::from_json(
-            r#"{"nodes": [[0.9,0.5,0.5],[1.2,0.5,0.5],[0.8,0.9,0.5],[1.1,1.3,0.5],
-                          [0.85,0.9,0.95],[1.1,1.05,1.2],[0.1,0.1,0.1],[-0.15,0.2,0.3]],
-                "struts": [[0,1],[2,3],[4,5],[6,7]],
-                "radii": [1,1.5,1,1,0.7,1.3,1,1]}"#,
-        )
-        .unwrap();
+        // Loose struts (not one lattice: a cell file would be refused), for the evaluation only.
+        let custom = UnitCell {
+            nodes: vec![
+                [0.9, 0.5, 0.5],
+                [1.2, 0.5, 0.5],
+                [0.8, 0.9, 0.5],
+                [1.1, 1.3, 0.5],
+                [0.85, 0.9, 0.95],
+                [1.1, 1.05, 1.2],
+                [0.1, 0.1, 0.1],
+                [-0.15, 0.2, 0.3],
+            ],
+            struts: vec![[0, 1], [2, 3], [4, 5], [6, 7]],
+            radii: vec![1.0, 1.5, 1.0, 1.0, 0.7, 1.3, 1.0, 1.0],
+        }
+        .canonical();
         let mut cells: Vec<(String, UnitCell)> = super::super::cell::BUILT_IN
             .iter()
             .map(|n| (n.to_string(), UnitCell::built_in(n).unwrap()))
