@@ -81,6 +81,43 @@ pub struct RadiusModel {
     pub closing: f64,
 }
 
+/// The distance to the nearest strut axis (over the strut's mean radius factor) anywhere in a
+/// cell: looked up in a field whose bins list only the struts within a short reach (a few per
+/// bin), and, for the rare point farther than that from every axis, in one that lists all.
+struct AxisDistance {
+    near: StrutField,
+    reach: f64,
+    all: std::sync::OnceLock<StrutField>,
+    cell: UnitCell,
+    size: Vec3,
+}
+
+impl AxisDistance {
+    fn new(cell: &UnitCell, size: Vec3) -> AxisDistance {
+        let reach = 0.3 * size.iter().cloned().fold(f64::INFINITY, f64::min);
+        AxisDistance {
+            near: StrutField::new(cell, size, [0.0; 3], 0.0, 0.0, reach),
+            reach,
+            all: std::sync::OnceLock::new(),
+            cell: cell.clone(),
+            size,
+        }
+    }
+
+    fn axis_distance(&self, p: Vec3) -> f64 {
+        let d = self.near.axis_distance(p);
+        if d < self.reach {
+            return d;
+        }
+        // No point of the cell is farther than half its diagonal from a node.
+        let all = self.all.get_or_init(|| {
+            let reach = 0.5 * self.size.iter().map(|s| s * s).sum::<f64>().sqrt();
+            StrutField::new(&self.cell, self.size, [0.0; 3], 0.0, 0.0, reach)
+        });
+        all.axis_distance(p)
+    }
+}
+
 /// Points per axis of the model's stratified set.
 const MODEL_POINTS: usize = 40;
 
@@ -94,7 +131,7 @@ const CLOSING_POINTS: usize = 48;
 /// two copies of one point in one cluster — is the moment the void percolates. Its radius is
 /// the point's axis distance. (Union–find with a period offset per point, as in Newman and
 /// Ziff's percolation algorithm, Phys. Rev. E 64, 016706, 2001.)
-fn closing_radius(field: &StrutField, size: Vec3, n: usize) -> f64 {
+fn closing_radius(field: &AxisDistance, size: Vec3, n: usize) -> f64 {
     let idx = |i: usize| [i / (n * n), (i / n) % n, i % n];
     let at = |c: [usize; 3]| (c[0] * n + c[1]) * n + c[2];
     let distances: Vec<f64> = (0..n * n * n)
@@ -173,8 +210,7 @@ impl RadiusModel {
     /// The model of `cell` with cells of `size` mm.
     pub fn new(cell: &UnitCell, size: Vec3) -> RadiusModel {
         // No point of the cell is farther than half its diagonal from a node.
-        let reach = 0.5 * size.iter().map(|s| s * s).sum::<f64>().sqrt();
-        let field = StrutField::new(cell, size, [0.0; 3], 0.0, 0.0, reach);
+        let field = AxisDistance::new(cell, size);
         let n = MODEL_POINTS;
         let mut radii: Vec<f64> = (0..n * n * n)
             .into_par_iter()
@@ -191,7 +227,8 @@ impl RadiusModel {
             })
             .collect();
         radii.sort_by(f64::total_cmp);
-        let max_radius = radii.last().copied().unwrap_or(reach) * (1.0 + 1e-9) + 1e-12;
+        let diagonal = size.iter().map(|s| s * s).sum::<f64>().sqrt();
+        let max_radius = radii.last().copied().unwrap_or(diagonal) * (1.0 + 1e-9) + 1e-12;
         let closing = closing_radius(&field, size, CLOSING_POINTS);
         RadiusModel {
             radii,
