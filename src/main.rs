@@ -2,7 +2,7 @@
 //! Exit codes: 0 success, 1 a check found defects, 2 bad input or arguments, 3 a backend failed
 //! unexpectedly (a bug to report).
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use latvox::Error;
 
 mod cli;
@@ -61,8 +61,36 @@ enum Command {
     Batch(cli::batch::BatchArgs),
 }
 
+/// The command line with a part file's options put in (`--part`, for `tpms` and `strut`).
+fn expanded_args() -> latvox::Result<Vec<String>> {
+    let argv: Vec<String> = std::env::args().collect();
+    // The subcommand: the first word that is not a global option or its value.
+    let mut i = 1;
+    while i < argv.len() {
+        match argv[i].as_str() {
+            "--threads" => i += 2,
+            a if a.starts_with('-') => i += 1,
+            _ => break,
+        }
+    }
+    match argv.get(i).map(String::as_str) {
+        Some(command @ ("tpms" | "strut")) => {
+            let tail = cli::part::expand(command, argv[i + 1..].to_vec())?;
+            Ok([&argv[..=i], &tail[..]].concat())
+        }
+        _ => Ok(argv),
+    }
+}
+
 fn main() {
-    let cli = match Cli::try_parse() {
+    let argv = expanded_args().unwrap_or_else(|e| {
+        eprintln!("latvox: {}", one_line(&e));
+        std::process::exit(e.exit_code());
+    });
+    let parsed = Cli::command()
+        .try_get_matches_from(argv)
+        .and_then(|m| Cli::from_arg_matches(&m).map(|c| (c, m)));
+    let (cli, matches) = match parsed {
         Ok(c) => c,
         Err(e) => {
             use clap::error::ErrorKind;
@@ -99,6 +127,19 @@ fn main() {
             .build_global();
         latvox::grid::set_backend_threads(n);
     }
+    // The part file (if asked for) is written once the part is made; its folder must take it.
+    let save_part = matches.subcommand().and_then(|(name, sub)| {
+        sub.try_get_one::<std::path::PathBuf>("save_part")
+            .ok()
+            .flatten()
+            .map(|p| (name.to_string(), p.clone(), sub.clone()))
+    });
+    if let Some((_, p, _)) = &save_part {
+        if let Err(e) = latvox::io::atomic::check_writable(p) {
+            eprintln!("latvox: {}", one_line(&e));
+            std::process::exit(e.exit_code());
+        }
+    }
     let result = match &cli.command {
         Command::Tpms(a) => cli::tpms::run(a, cli.quiet),
         Command::Strut(a) => cli::strut::run(a, cli.quiet),
@@ -108,6 +149,16 @@ fn main() {
         Command::Topo(a) => cli::topo::run(a, cli.quiet),
         Command::Batch(a) => cli::batch::run(a, cli.quiet),
     };
+    let result = result.and_then(|code| {
+        if let Some((name, path, sub)) = &save_part {
+            let cmd = Cli::command();
+            let cmd = cmd
+                .find_subcommand(name)
+                .expect("the subcommand that ran is a subcommand");
+            cli::part::save(path, name, cmd, sub)?;
+        }
+        Ok(code)
+    });
     match result {
         Ok(code) => std::process::exit(code),
         Err(e) => {

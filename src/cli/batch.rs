@@ -174,6 +174,11 @@ where
         .disable_help_flag(true);
     cmd.build();
     let argv = command_line(&cmd, job)?;
+    // A job may name a part file (`part = "octet.toml"`): its settings, the job's own first.
+    let argv = match name {
+        "tpms" | "strut" => super::part::expand(name, argv).map_err(|e| e.to_string())?,
+        _ => argv,
+    };
     let matches = cmd.try_get_matches_from_mut(argv).map_err(clap_message)?;
     let args = A::from_arg_matches(&matches).map_err(clap_message)?;
     Ok(Box::new(args))

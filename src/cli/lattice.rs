@@ -50,6 +50,18 @@ impl BoxArgs {
     }
 }
 
+/// Part files: the settings of a part saved, or given back.
+#[derive(Args, Clone)]
+pub struct PartArgs {
+    /// Save the settings that define this part (all but where its files go) to a TOML part
+    /// file, once the part is made.
+    #[arg(long, value_name = "FILE.toml")]
+    pub save_part: Option<PathBuf>,
+    /// Make the part a part file describes (options given here override the file's).
+    #[arg(long, value_name = "FILE.toml")]
+    pub part: Option<PathBuf>,
+}
+
 /// How the part is meshed, checked and written.
 #[derive(Args, Clone)]
 pub struct MeshArgs {

@@ -5,6 +5,7 @@ pub mod batch;
 pub mod check;
 pub mod lattice;
 pub(crate) mod out;
+pub mod part;
 pub mod repair;
 pub mod strut;
 pub mod topo;

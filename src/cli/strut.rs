@@ -1,6 +1,6 @@
 //! `latvox strut`: a closed strut (beam) lattice at an exact volume fraction or strut radius.
 
-use super::lattice::{human, print_part, triple, BoxArgs, MeshArgs};
+use super::lattice::{human, print_part, triple, BoxArgs, MeshArgs, PartArgs};
 use super::out::outln;
 use super::{parse_density, parse_length0, parse_positive, write_json};
 use clap::Args;
@@ -26,6 +26,10 @@ Examples:
 
   # The same lattice as 3MF beams (each strut a beam, the box a clipping mesh): kilobytes
   latvox strut --cell octet --density 0.2 --cells 10 --cell-size 5 --beams -o octet-beams.3mf
+
+  # Save the part's settings, then make it again with 8 cells a side
+  latvox strut --cell octet --density 0.2 --cells 4 -o octet.stl --save-part octet.toml
+  latvox strut --part octet.toml --cells 8 -o octet-8.stl
 
   # 30×30×30 cells: copies of a meshed template streamed to the file, memory flat
   latvox strut --cell kelvin --density 0.1 --cells 30 --cell-size 3 --resolution 16 -o big.stl
@@ -66,6 +70,9 @@ pub struct StrutArgs {
     /// Meshing and output.
     #[command(flatten)]
     pub mesh: MeshArgs,
+    /// Part files.
+    #[command(flatten)]
+    pub part_file: PartArgs,
 }
 
 impl StrutArgs {

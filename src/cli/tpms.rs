@@ -1,6 +1,6 @@
 //! `latvox tpms`: a closed TPMS lattice at an exact volume fraction.
 
-use super::lattice::{human, print_part, triple, BoxArgs, MeshArgs};
+use super::lattice::{human, print_part, triple, BoxArgs, MeshArgs, PartArgs};
 use super::out::outln;
 use super::parse_density;
 use clap::Args;
@@ -29,6 +29,10 @@ Examples:
   # --no-instancing)
   latvox tpms --type d --density 0.25 --cells 20 --cell-size 6 --no-instancing --memory 1G -o d.stl
 
+  # Save the part's settings as a part file; make it again, here with finer voxels
+  latvox tpms --type d --density 0.25 --cells 4 -o d.stl --save-part d.toml
+  latvox tpms --part d.toml --resolution 48 -o d-fine.stl
+
 Types: p (Schwarz primitive), g|gyroid, d (Schwarz diamond), iwp (Schoen I-WP),
        s (Fischer–Koch S), frd (Schoen F-RD), n|neovius.
 Structures: net (solid on one side of F = t), sheet (solid where |F| ≤ t).
@@ -55,6 +59,9 @@ pub struct TpmsArgs {
     /// Meshing and output.
     #[command(flatten)]
     pub mesh: MeshArgs,
+    /// Part files.
+    #[command(flatten)]
+    pub part_file: PartArgs,
 }
 
 pub(crate) fn parse_surface(s: &str) -> std::result::Result<Surface, String> {

@@ -1,0 +1,212 @@
+//! Part files: the settings that define a lattice part (`tpms` or `strut`), saved as TOML with
+//! `--save-part FILE.toml` and given back with `--part FILE.toml`, so that a part can be made
+//! again, varied, or handed to another tool.
+//!
+//! A part file holds `command` and the subcommand's own long options, with the same names and
+//! values as on the command line (`cell-size = [5.0, 5.0, 5.0]` is `--cell-size 5,5,5`). Given
+//! with `--part`, its options come first and the command line's override them: an option given
+//! on the command line replaces the file's (and `--radius` replaces the file's `--density`, and
+//! the reverse). Where the file names a cell file by a relative path, it is relative to the
+//! part file.
+
+use latvox::{Error, Result};
+use std::path::Path;
+
+/// The options that define a part, per subcommand (beside [`COMMON`]): everything but where
+/// its files go.
+const PART_KEYS: &[(&str, &[&str])] = &[
+    ("tpms", &["type", "structure", "density", "allow-islands"]),
+    ("strut", &["cell", "density", "radius", "blend"]),
+];
+
+/// The options of the box and the meshing that define any lattice part.
+const COMMON: &[&str] = &[
+    "cells",
+    "cell-size",
+    "size",
+    "origin",
+    "resolution",
+    "fixed-resolution",
+    "adaptivity",
+    "keep-fragments",
+];
+
+/// Options that exclude each other: giving one on the command line drops the other from the
+/// file.
+const EXCLUSIVE: &[[&str; 2]] = &[["density", "radius"]];
+
+/// The short forms of long options, to tell whether the command line gave one.
+const SHORT: &[(&str, &str)] = &[("type", "-t"), ("density", "-d"), ("resolution", "-r")];
+
+fn keys(command: &str) -> Vec<&'static str> {
+    let own = PART_KEYS
+        .iter()
+        .find(|(c, _)| *c == command)
+        .map_or(&[][..], |(_, k)| k);
+    own.iter().chain(COMMON).copied().collect()
+}
+
+/// Writes the part file of `command` (its clap command `cmd`) run with `matches`, atomically.
+pub fn save(
+    path: &Path,
+    command: &str,
+    cmd: &clap::Command,
+    matches: &clap::ArgMatches,
+) -> Result<()> {
+    let mut table = toml::Table::new();
+    table.insert("command".into(), toml::Value::String(command.into()));
+    for key in keys(command) {
+        let Some(arg) = cmd.get_arguments().find(|a| a.get_long() == Some(key)) else {
+            continue;
+        };
+        let Ok(raw) = matches.try_get_raw(arg.get_id().as_str()) else {
+            continue;
+        };
+        let Some(raw) = raw else { continue };
+        let raw: Vec<String> = raw.map(|v| v.to_string_lossy().into_owned()).collect();
+        let value = match raw.as_slice() {
+            // A switch: kept only when on.
+            [v] if v == "true" || v == "false" => {
+                if v == "false" {
+                    continue;
+                }
+                toml::Value::Boolean(true)
+            }
+            [v] => value_of(v),
+            _ => continue,
+        };
+        table.insert(key.into(), value);
+    }
+    let text = format!(
+        "# A latvox part: `latvox {command} --part {}` makes it again; options given on the command\n# line override these.\n{}",
+        path.file_name().map_or(String::new(), |f| f.to_string_lossy().into_owned()),
+        toml::to_string(&table).map_err(|e| Error::invalid(e.to_string()))?
+    );
+    latvox::io::atomic::write_atomic(path, |w| w.write_all(text.as_bytes()))
+}
+
+/// A command-line value as TOML: a number, a list of numbers (`4,4,2`), or a string.
+fn value_of(v: &str) -> toml::Value {
+    let number = |s: &str| -> Option<toml::Value> {
+        let s = s.trim();
+        s.parse::<i64>()
+            .map(toml::Value::Integer)
+            .ok()
+            .or_else(|| s.parse::<f64>().ok().map(toml::Value::Float))
+    };
+    if let Some(n) = number(v) {
+        return n;
+    }
+    if v.contains(',') {
+        let items: Option<Vec<toml::Value>> = v.split(',').map(number).collect();
+        if let Some(items) = items {
+            return toml::Value::Array(items);
+        }
+    }
+    toml::Value::String(v.into())
+}
+
+/// A TOML value as a command-line value.
+fn arg_of(v: &toml::Value) -> Option<String> {
+    Some(match v {
+        toml::Value::String(s) => s.clone(),
+        toml::Value::Integer(i) => i.to_string(),
+        toml::Value::Float(f) => f.to_string(),
+        toml::Value::Boolean(b) => b.to_string(),
+        toml::Value::Array(a) => a.iter().map(arg_of).collect::<Option<Vec<_>>>()?.join(","),
+        _ => return None,
+    })
+}
+
+/// `argv` (a subcommand's arguments, after its name) with the options of the part file it
+/// names with `--part` put in front, those the command line gives itself left out.
+pub fn expand(command: &str, argv: Vec<String>) -> Result<Vec<String>> {
+    let at = argv
+        .iter()
+        .position(|a| a == "--part" || a.starts_with("--part="));
+    let Some(at) = at else { return Ok(argv) };
+    let path = match argv[at].strip_prefix("--part=") {
+        Some(p) => p.to_string(),
+        None => argv
+            .get(at + 1)
+            .cloned()
+            .ok_or_else(|| Error::invalid("--part needs a part file (FILE.toml)"))?,
+    };
+    let path = Path::new(&path);
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+        Error::invalid(format!(
+            "{}: not a part file: {}",
+            path.display(),
+            e.message()
+        ))
+    })?;
+    match table.get("command").and_then(toml::Value::as_str) {
+        Some(c) if c == command => {}
+        Some(c) => {
+            return Err(Error::invalid(format!(
+                "{} is a part of `latvox {c}`, not of `latvox {command}`",
+                path.display()
+            )))
+        }
+        None => {
+            return Err(Error::invalid(format!(
+                "{}: a part file needs `command` (\"tpms\" or \"strut\")",
+                path.display()
+            )))
+        }
+    }
+    let given = |key: &str| {
+        let long = format!("--{key}");
+        let short = SHORT.iter().find(|(k, _)| *k == key).map(|(_, s)| *s);
+        argv.iter().any(|a| {
+            a == &long
+                || a.starts_with(&format!("{long}="))
+                || short.is_some_and(|s| a == s || (a.starts_with(s) && !a.starts_with("--")))
+        })
+    };
+    let mut front = Vec::new();
+    for (key, value) in &table {
+        if key == "command" {
+            continue;
+        }
+        let key = key.replace('_', "-");
+        if !keys(command).contains(&key.as_str()) {
+            return Err(Error::invalid(format!(
+                "{}: '{key}' is not a setting of a {command} part (settings: {})",
+                path.display(),
+                keys(command).join(", ")
+            )));
+        }
+        let excluded = EXCLUSIVE
+            .iter()
+            .filter(|pair| pair.contains(&key.as_str()))
+            .flat_map(|pair| pair.iter())
+            .any(|k| given(k));
+        if given(&key) || excluded {
+            continue;
+        }
+        let mut arg = arg_of(value).ok_or_else(|| {
+            Error::invalid(format!(
+                "{}: '{key}' is not a value an option takes",
+                path.display()
+            ))
+        })?;
+        if key == "cell" && arg.to_ascii_lowercase().ends_with(".json") {
+            let cell = Path::new(&arg);
+            if cell.is_relative() {
+                if let Some(dir) = path.parent() {
+                    arg = dir.join(cell).display().to_string();
+                }
+            }
+        }
+        match value {
+            // A switch in the file: on when true.
+            toml::Value::Boolean(true) => front.push(format!("--{key}")),
+            toml::Value::Boolean(false) => {}
+            _ => front.push(format!("--{key}={arg}")),
+        }
+    }
+    front.extend(argv);
+    Ok(front)
+}
