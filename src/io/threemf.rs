@@ -318,6 +318,30 @@ pub(crate) fn triangle_line(w: &mut dyn Write, t: &[u32]) -> std::io::Result<()>
     )
 }
 
+/// Writes a 3MF package to `w`: the content types, the relationship to the model, and the
+/// model XML that `model` writes.
+fn package(
+    w: &mut dyn Write,
+    model: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
+    let opts = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    let z = |e: zip::result::ZipError| std::io::Error::other(e);
+    zip.start_file("[Content_Types].xml", opts).map_err(z)?;
+    zip.write_all(CONTENT_TYPES)?;
+    zip.start_file("_rels/.rels", opts).map_err(z)?;
+    zip.write_all(rels().as_bytes())?;
+    zip.start_file("3D/3dmodel.model", opts).map_err(z)?;
+    {
+        let mut x = std::io::BufWriter::with_capacity(1 << 16, &mut zip);
+        model(&mut x)?;
+        x.flush()?;
+    }
+    let buf = zip.finish().map_err(z)?.into_inner();
+    w.write_all(&buf)
+}
+
 /// Writes a 3MF package with one mesh object and one build item.
 pub fn write(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
     if let Some(t) = mesh
@@ -330,30 +354,18 @@ pub fn write(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
             format!("3MF forbids degenerate triangles and triangle {t} repeats a vertex (run `latvox repair`)"),
         ));
     }
-    let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
-    let opts = zip::write::SimpleFileOptions::default()
-        .compression_method(zip::CompressionMethod::Deflated);
-    let z = |e: zip::result::ZipError| std::io::Error::other(e);
-    zip.start_file("[Content_Types].xml", opts).map_err(z)?;
-    zip.write_all(CONTENT_TYPES)?;
-    zip.start_file("_rels/.rels", opts).map_err(z)?;
-    zip.write_all(rels().as_bytes())?;
-    zip.start_file("3D/3dmodel.model", opts).map_err(z)?;
-    {
-        let mut x = std::io::BufWriter::with_capacity(1 << 16, &mut zip);
+    package(w, |x| {
         x.write_all(model_head().as_bytes())?;
         for p in mesh.positions.chunks_exact(3) {
-            vertex_line(&mut x, p)?;
+            vertex_line(x, p)?;
         }
         x.write_all(MODEL_MIDDLE.as_bytes())?;
         for t in mesh.indices.chunks_exact(3) {
-            triangle_line(&mut x, t)?;
+            triangle_line(x, t)?;
         }
         x.write_all(MODEL_TAIL.as_bytes())?;
-        x.flush()?;
-    }
-    let buf = zip.finish().map_err(z)?.into_inner();
-    w.write_all(&buf)
+        Ok(())
+    })
 }
 
 const BEAM_NS: &str = "http://schemas.microsoft.com/3dmanufacturing/beamlattice/2017/02";
@@ -382,17 +394,7 @@ pub struct BeamModel {
 /// Writes `m` as a 3MF package: a lattice-only mesh object (no triangles) holding the beams,
 /// and, when the beams are clipped, the box as a mesh object it names as its clipping mesh.
 pub fn write_beams(m: &BeamModel, w: &mut dyn Write) -> std::io::Result<()> {
-    let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
-    let opts = zip::write::SimpleFileOptions::default()
-        .compression_method(zip::CompressionMethod::Deflated);
-    let z = |e: zip::result::ZipError| std::io::Error::other(e);
-    zip.start_file("[Content_Types].xml", opts).map_err(z)?;
-    zip.write_all(CONTENT_TYPES)?;
-    zip.start_file("_rels/.rels", opts).map_err(z)?;
-    zip.write_all(rels().as_bytes())?;
-    zip.start_file("3D/3dmodel.model", opts).map_err(z)?;
-    {
-        let mut x = std::io::BufWriter::with_capacity(1 << 16, &mut zip);
+    package(w, |x| {
         write!(
             x,
             "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" xml:lang=\"en-US\" xmlns=\"{MODEL_NS}\" xmlns:b=\"{BEAM_NS}\" requiredextensions=\"b\">\n<metadata name=\"Application\">latvox</metadata>\n<resources>\n"
@@ -422,7 +424,7 @@ pub fn write_beams(m: &BeamModel, w: &mut dyn Write) -> std::io::Result<()> {
                 [1, 3, 7],
                 [1, 7, 5],
             ] {
-                triangle_line(&mut x, &t)?;
+                triangle_line(x, &t)?;
             }
             x.write_all(b"</triangles>\n</mesh>\n</object>\n")?;
             2
@@ -475,10 +477,8 @@ pub fn write_beams(m: &BeamModel, w: &mut dyn Write) -> std::io::Result<()> {
             x,
             "</b:beamlattice>\n</mesh>\n</object>\n</resources>\n<build>\n<item objectid=\"{lattice_id}\"/>\n</build>\n</model>"
         )?;
-        x.flush()?;
-    }
-    let buf = zip.finish().map_err(z)?.into_inner();
-    w.write_all(&buf)
+        Ok(())
+    })
 }
 
 /// `s` with XML's special characters escaped, for an attribute.
