@@ -33,10 +33,15 @@ uint64_t vdb_active_voxels(const VdbGrid& grid);
 uint64_t vdb_memory_bytes(const VdbGrid& grid);
 void vdb_write(const VdbGrid& grid, rust::Str path);
 
-// vdb_from_mesh.cc: triangles to a level set (meshToLevelSet); index (0,0,0) at the origin.
+// vdb_from_mesh.cc: triangles to a signed distance field (meshToSignedDistanceField), bands
+// in voxels outside and inside; index (0,0,0) at the origin.
 std::unique_ptr<VdbGrid> vdb_grid_from_mesh(rust::Slice<const float> positions,
                                             rust::Slice<const uint32_t> indices,
-                                            double voxel_size, float half_width);
+                                            double voxel_size, float exterior_width,
+                                            float interior_width);
+
+// vdb_probe.cc: the grid's values at world points (xyz triples), trilinear between voxels.
+void vdb_probe(const VdbGrid& grid, rust::Slice<const double> points, rust::Slice<float> values);
 
 // vdb_filter.cc: the level set rebuilt as a signed distance `half_width` voxels each side of
 // the surface, then `iterations` passes of LevelSetFilter.

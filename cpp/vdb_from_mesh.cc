@@ -14,7 +14,8 @@ namespace latvox {
 
 std::unique_ptr<VdbGrid> vdb_grid_from_mesh(rust::Slice<const float> positions,
                                             rust::Slice<const uint32_t> indices,
-                                            double voxel_size, float half_width) {
+                                            double voxel_size, float exterior_width,
+                                            float interior_width) {
   vdb_init();
   if (!(voxel_size > 0.0) || !std::isfinite(voxel_size))
     throw std::invalid_argument("voxel size must be positive and finite");
@@ -31,8 +32,14 @@ std::unique_ptr<VdbGrid> vdb_grid_from_mesh(rust::Slice<const float> positions,
     tris[f] = openvdb::Vec3I(indices[3 * f], indices[3 * f + 1], indices[3 * f + 2]);
   }
   auto xform = openvdb::math::Transform::createLinearTransform(voxel_size);
-  return vdb_handle(
-      openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xform, points, tris, half_width));
+  if (!(exterior_width >= 1.0f) || !(interior_width >= 1.0f) || !std::isfinite(exterior_width) ||
+      !std::isfinite(interior_width))
+    throw std::invalid_argument("band widths must be at least one voxel");
+  // Beyond the bands the grid holds +exterior outside and -interior inside (inactive tiles): a
+  // lower bound on the distance either way.
+  const std::vector<openvdb::Vec4I> quads;
+  return vdb_handle(openvdb::tools::meshToSignedDistanceField<openvdb::FloatGrid>(
+      *xform, points, tris, quads, exterior_width, interior_width));
 }
 
 }  // namespace latvox

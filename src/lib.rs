@@ -59,6 +59,7 @@ pub mod check;
 pub mod error;
 pub(crate) mod ffi;
 pub mod field;
+pub mod fill;
 pub mod grid;
 pub mod interpret;
 pub mod io;

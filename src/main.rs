@@ -18,7 +18,7 @@ Exit codes (every command):
 #[command(
     name = "latvox",
     version,
-    about = "Sparse-volume voxel engine for additive manufacturing: TPMS and strut lattices at exact density, verified by CGAL",
+    about = "Sparse-volume voxel engine for additive manufacturing: TPMS and strut lattices and lattice-filled parts at exact density, verified by CGAL",
     long_about = None,
     after_help = EXIT_CODES
 )]
@@ -42,6 +42,10 @@ enum Command {
     /// exact volume fraction or strut radius.
     #[command(after_help = cli::strut::EXAMPLES)]
     Strut(cli::strut::StrutArgs),
+    /// Fill a part with a lattice: a solid skin of the part's shape, its core a TPMS or strut
+    /// lattice at an exact density, solids kept whole where asked.
+    #[command(after_help = cli::fill::EXAMPLES)]
+    Fill(cli::fill::FillArgs),
     /// Check a mesh file: every defect counted (holes, non-manifold, winding, normals, degenerate
     /// and duplicate facets, T-junctions, self-intersections), per shell too.
     #[command(after_help = cli::check::EXAMPLES)]
@@ -143,6 +147,7 @@ fn main() {
     let result = match &cli.command {
         Command::Tpms(a) => cli::tpms::run(a, cli.quiet),
         Command::Strut(a) => cli::strut::run(a, cli.quiet),
+        Command::Fill(a) => cli::fill::run(a, cli.quiet),
         Command::Check(a) => cli::check::run(a, cli.quiet),
         Command::Repair(a) => cli::repair::run(a, cli.quiet),
         Command::Topopt(a) => cli::topopt::run(a, cli.quiet),

@@ -207,7 +207,7 @@ pub(crate) fn print_part(r: &PartReport) {
             None => "not checked (meshed in tiles without a template of its cells)".to_string(),
             Some(true) if f.count == 0 => "one".to_string(),
             Some(true) => format!(
-                "one ({} fragment{plural} cut loose by the box removed, {:.3} mm³)",
+                "one ({} fragment{plural} cut loose removed, {:.3} mm³)",
                 f.count, f.volume
             ),
             Some(false) => format!(

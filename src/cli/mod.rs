@@ -7,6 +7,7 @@ pub mod lattice;
 pub(crate) mod out;
 pub mod part;
 pub mod repair;
+pub mod fill;
 pub mod strut;
 pub mod topo;
 pub mod topopt;

@@ -43,8 +43,10 @@ pub(crate) mod ffi {
             positions: &[f32],
             indices: &[u32],
             voxel_size: f64,
-            half_width: f32,
+            exterior_width: f32,
+            interior_width: f32,
         ) -> Result<UniquePtr<VdbGrid>>;
+        fn vdb_probe(grid: &VdbGrid, points: &[f64], values: &mut [f32]);
         fn vdb_smoothed(
             grid: &VdbGrid,
             mode: SmoothingMode,

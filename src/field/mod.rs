@@ -70,6 +70,13 @@ impl<T: Field + ?Sized> Field for &T {
     }
 }
 
+/// Quilez's polynomial smooth minimum of radius `k > 0`: `min(a, b)` where they differ by more
+/// than `k`, below it by up to `k/4` where they meet; 1-Lipschitz when `a` and `b` are.
+pub fn smooth_min(a: f64, b: f64, k: f64) -> f64 {
+    let h = (k - (a - b).abs()).max(0.0) / k;
+    a.min(b) - 0.25 * h * h * k
+}
+
 /// An axis-aligned box `[min, max]`, as an exact signed distance field.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Aabb {

@@ -12,9 +12,26 @@ impl Grid {
     /// outside, so overlapping shells merge and facet orientation does not matter. OpenVDB's index
     /// (0, 0, 0) sits at the coordinate origin.
     pub fn from_mesh(mesh: &Mesh, voxel: f64, half_width: f64) -> Result<Grid> {
-        let inner =
-            ffi::vdb_grid_from_mesh(&mesh.positions, &mesh.indices, voxel, half_width as f32)
-                .backend("building a level set from the mesh (OpenVDB meshToLevelSet)")?;
+        Self::distance_to_mesh(mesh, voxel, half_width, half_width)
+    }
+
+    /// The signed distance to a triangle mesh at `voxel` mm, as [`Grid::from_mesh`], exact
+    /// `exterior` voxels outside the surface and `interior` voxels inside it; beyond, the grid
+    /// holds `±exterior·voxel` and `−interior·voxel` (lower bounds on the distance).
+    pub fn distance_to_mesh(
+        mesh: &Mesh,
+        voxel: f64,
+        exterior: f64,
+        interior: f64,
+    ) -> Result<Grid> {
+        let inner = ffi::vdb_grid_from_mesh(
+            &mesh.positions,
+            &mesh.indices,
+            voxel,
+            exterior as f32,
+            interior as f32,
+        )
+        .backend("building a level set from the mesh (OpenVDB meshToSignedDistanceField)")?;
         // Sample `frame + i` of the spec is OpenVDB's voxel `i`, at `i·voxel` mm.
         let (lo, hi) = match mesh.bounds() {
             Some(b) => (
@@ -27,7 +44,7 @@ impl Grid {
             origin: lo.map(|i| (i as f64 - 0.5) * voxel),
             voxel,
             dims: [0, 1, 2].map(|a| hi[a] - lo[a] + 1),
-            half_width,
+            half_width: exterior,
         };
         Ok(Grid {
             inner: inner.into(),

@@ -16,6 +16,7 @@ use crate::ffi::vdb::{ffi, OwnedGrid};
 use crate::field::{Aabb, Vec3};
 
 mod from_mesh;
+mod probe;
 mod sample;
 mod smooth;
 mod to_mesh;

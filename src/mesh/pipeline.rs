@@ -66,6 +66,12 @@ pub trait Solid: Sync {
     /// The cell size per axis, when the solid repeats with cells starting at its box's lower
     /// corner.
     fn period(&self) -> Option<Vec3>;
+    /// Whether the field is exact enough to snap vertices onto (a field interpolated from
+    /// samples is not: OpenVDB's vertices already lie on it as closely as it is known, and
+    /// snapping onto its creases folds triangles).
+    fn snaps(&self) -> bool {
+        true
+    }
 }
 
 /// Solids indexed by a level; the solid grows with the level.
@@ -79,6 +85,12 @@ pub trait Family: Sync {
     fn model_fraction(&self, level: f64) -> f64;
     /// The inverse of [`Family::model_fraction`].
     fn model_level(&self, fraction: f64) -> f64;
+    /// The fraction the search aims at, of a part in `bounds` that encloses `volume` mm³: its
+    /// share of the box unless the family measures its density against something else (a
+    /// filled part: the lattice's share of the region it fills).
+    fn fraction(&self, volume: f64, bounds: &Aabb) -> f64 {
+        volume / bounds.volume()
+    }
 }
 
 /// Statistics of meshing.
@@ -160,7 +172,12 @@ pub fn mesh_keyed<S: Solid + ?Sized>(
     };
     drop(grid);
     let t = Instant::now();
-    let snap = crate::mesh::snap::snap_within(&mut keyed, &*field, &bounds, &spec, snap_within);
+    let snap = if solid.snaps() {
+        crate::mesh::snap::snap_within(&mut keyed, &*field, &bounds, &spec, snap_within)
+    } else {
+        keyed.triangulate();
+        SnapStats::default()
+    };
     Ok((
         keyed,
         MeshingStats {
@@ -279,7 +296,6 @@ pub fn measure<F: Family>(
     o: &Options,
 ) -> Result<Measured> {
     let solid = family.at(level);
-    let box_volume = solid.bounds().volume();
     let template = |plan| Template::build(&solid, voxel, plan, o.keep_fragments);
     let (made, volume, fragments, meshing) = match route {
         Route::Instanced(plan) | Route::Whole(Some(plan)) | Route::Tiled(_, Some(plan)) => {
@@ -313,11 +329,23 @@ pub fn measure<F: Family>(
     };
     Ok(Measured {
         level,
-        fraction: volume / box_volume,
+        fraction: family.fraction(volume, &solid.bounds()),
         made,
         fragments,
         meshing,
     })
+}
+
+/// The volume of `solid` meshed on `route` (whole, or tile by tile without keeping the tiles),
+/// fragments included, mm³.
+pub fn solid_volume<S: Solid>(solid: &S, voxel: f64, route: Route) -> Result<(f64, MeshingStats)> {
+    match route {
+        Route::Tiled(edge, _) => tiled_volume(solid, voxel, edge),
+        _ => {
+            let (mesh, stats) = mesh_keyed(solid, part_spec(solid, voxel), None, 0.0, None)?;
+            Ok((keyed_volume(&mesh), stats))
+        }
+    }
 }
 
 /// Enclosed volume of a keyed mesh as it is written (single-precision corners), mm³.

@@ -169,6 +169,16 @@ impl PartReport {
         report
     }
 
+    /// Measures the density against another base than the box (a filled part: the lattice's
+    /// share of the region it fills): `achieved` against `target`, the warnings redone.
+    pub fn density_against(&mut self, target: f64, achieved: f64) {
+        self.target_density = Some(target);
+        self.achieved_density = achieved;
+        self.density_error = Some(achieved - target);
+        self.density_met = Some((achieved - target).abs() <= PROMISE);
+        self.warnings = self.written_warnings();
+    }
+
     /// What the written mesh says that the user should hear: a missed density (a bug), a
     /// failed CGAL check, fragments cut loose by the box.
     fn written_warnings(&self) -> Vec<String> {
@@ -188,7 +198,7 @@ impl PartReport {
         let fragments = &self.fragments;
         if fragments.count > 0 {
             warnings.push(format!(
-                "{} fragment{} cut loose by the box ({:.3} mm³) {}",
+                "{} fragment{} cut loose by the box or the part's surface ({:.3} mm³) {}",
                 fragments.count,
                 if fragments.count == 1 { "" } else { "s" },
                 fragments.volume,

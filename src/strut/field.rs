@@ -18,7 +18,7 @@
 //! minimum), still 1-Lipschitz, so the clearance is the value's magnitude.
 
 use super::cell::UnitCell;
-use crate::field::{periodic, Field, Vec3};
+use crate::field::{periodic, smooth_min, Field, Vec3};
 
 /// Bins per axis of the cell's index.
 const BINS: usize = 4;
@@ -269,13 +269,6 @@ impl Field for StrutField {
             }
         }
     }
-}
-
-/// Quilez's polynomial smooth minimum of radius `k`: `min(a, b)` where they differ by more than
-/// `k`, below it by up to `k/4` where they meet; 1-Lipschitz.
-fn smooth_min(a: f64, b: f64, k: f64) -> f64 {
-    let h = (k - (a - b).abs()).max(0.0) / k;
-    a.min(b) - 0.25 * h * h * k
 }
 
 fn add(a: Vec3, b: Vec3) -> Vec3 {

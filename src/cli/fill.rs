@@ -1,0 +1,189 @@
+//! `latvox fill`: a part kept as a solid skin, its core filled with a lattice at an exact
+//! density, solids kept whole where asked.
+
+use super::lattice::{human, print_part, triple, MeshArgs};
+use super::out::outln;
+use super::tpms::parse_structure;
+use super::{parse_density, parse_length0, parse_positive3};
+use clap::Args;
+use latvox::fill::{FillJob, FillReport, Infilling};
+use latvox::io::ReadOptions;
+use latvox::strut::cell::BUILT_IN;
+use latvox::strut::UnitCell;
+use latvox::tpms::{Structure, Surface};
+use latvox::{Error, Result};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  # A bracket with a 1 mm solid skin, its core a gyroid at 20 % density in 4 mm cells
+  latvox fill bracket.stl --skin 1 --lattice gyroid --cell-size 4 --density 0.2 -o filled.stl
+
+  # An octet truss inside, joined to the skin by 0.3 mm fillets, two bosses kept solid
+  latvox fill grip.stl --lattice octet --cell-size 5 --density 0.15 --blend 0.3 \\
+      --keep boss1.stl --keep boss2.stl -o grip-filled.stl --report grip.json
+
+  # No skin: the part cut from a sheet gyroid, an open-cell part
+  latvox fill implant.stl --no-skin --lattice gyroid --structure sheet --cell-size 3 \\
+      --density 0.3 -o implant-open.stl
+
+Lattices: TPMS p, gyroid (g), d, iwp, s, frd, neovius (n), as net or sheet (--structure);
+struts sc, bcc, bccz, fcc, fccz, octet, kelvin, diamond, rhombic; or a strut cell file (.json).
+The part is read from STL, OBJ, OFF, PLY or 3MF; one that is not closed is mended with latvox's
+repair first, or refused when repair cannot close it. --density is the lattice's volume
+fraction in the region it fills (the part less its skin and the kept solids): latvox meshes the
+part solid and the skin alone to measure that region, then finds the lattice level at which the
+written mesh has the density. Lattice pieces the part's surface cuts loose from the rest are
+removed (counted in the summary and report), so the part is one piece; CGAL checks the mesh.";
+
+#[derive(Args)]
+pub struct FillArgs {
+    /// The part to fill: a closed mesh (.stl, .obj, .off, .ply, .3mf).
+    #[arg(value_name = "PART")]
+    pub input: PathBuf,
+    /// Thickness of the solid skin kept inside the part's surface, mm.
+    #[arg(long, value_name = "MM", default_value_t = 1.0, value_parser = parse_length0, allow_hyphen_values = true)]
+    pub skin: f64,
+    /// No skin: the lattice cut by the part's surface (an open-cell part).
+    #[arg(long, conflicts_with = "skin")]
+    pub no_skin: bool,
+    /// The lattice: a TPMS (p, gyroid, d, iwp, s, frd, neovius), a strut cell (sc, bcc, bccz,
+    /// fcc, fccz, octet, kelvin, diamond, rhombic) or a strut cell file (.json).
+    #[arg(long, value_name = "NAME|FILE.json", default_value = "gyroid")]
+    pub lattice: String,
+    /// For a TPMS lattice: net (F ≤ t) or sheet (|F| ≤ t).
+    #[arg(long, value_name = "net|sheet", default_value = "net", value_parser = parse_structure)]
+    pub structure: Structure,
+    /// Cell size in mm: A or AX,AY,AZ (cells start at the lower corner of the part's box).
+    #[arg(long, value_name = "MM[,MM,MM]", default_value = "5", value_parser = parse_positive3, allow_hyphen_values = true)]
+    pub cell_size: [f64; 3],
+    /// The lattice's volume fraction in the region it fills, in (0, 1).
+    #[arg(long, short = 'd', default_value_t = 0.2, value_parser = parse_density, allow_hyphen_values = true)]
+    pub density: f64,
+    /// Fillet the lattice into the skin (and struts at their joints): smooth minimum over this
+    /// many mm (0: a sharp union).
+    #[arg(long, value_name = "MM", default_value_t = 0.0, value_parser = parse_length0, allow_hyphen_values = true)]
+    pub blend: f64,
+    /// A solid kept whole (a boss, a flange), unioned with the filled part; repeat for more.
+    #[arg(long, value_name = "SOLID")]
+    pub keep: Vec<PathBuf>,
+    /// Meshing and output.
+    #[command(flatten)]
+    pub mesh: MeshArgs,
+}
+
+/// Reads a mesh file for the job, naming it in errors.
+fn read(path: &Path) -> Result<(String, latvox::mesh::Mesh)> {
+    let loaded = latvox::io::read(path, &ReadOptions::default())?;
+    Ok((path.display().to_string(), loaded.mesh))
+}
+
+impl FillArgs {
+    /// The lattice the option names: a TPMS, a built-in strut cell, or a cell file.
+    fn infilling(&self) -> Result<(Infilling, String)> {
+        let name = self.lattice.trim();
+        let lower = name.to_ascii_lowercase();
+        if let Some(surface) = Surface::parse(&lower) {
+            let s = Infilling::Tpms {
+                surface,
+                structure: self.structure,
+            };
+            return Ok((s, format!("{} {}", surface.name(), self.structure.name())));
+        }
+        if BUILT_IN.contains(&lower.as_str()) {
+            let cell = Arc::new(UnitCell::built_in(&lower)?);
+            return Ok((Infilling::Strut { cell }, lower));
+        }
+        let path = Path::new(name);
+        if lower.ends_with(".json") || path.exists() {
+            let cell = Arc::new(UnitCell::from_file(path)?);
+            return Ok((Infilling::Strut { cell }, name.to_string()));
+        }
+        Err(Error::invalid(format!(
+            "unknown lattice '{name}' (known: p, gyroid, d, iwp, s, frd, neovius, {}, or a cell file .json)",
+            BUILT_IN.join(", ")
+        )))
+    }
+
+    /// The job the options describe.
+    pub fn job(&self) -> Result<FillJob> {
+        let (lattice, lattice_name) = self.infilling()?;
+        let (part_name, part) = read(&self.input)?;
+        let keep = self
+            .keep
+            .iter()
+            .map(|k| read(k))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(FillJob {
+            part,
+            part_name,
+            keep,
+            skin: if self.no_skin { 0.0 } else { self.skin },
+            lattice,
+            lattice_name,
+            cell: self.cell_size,
+            density: self.density,
+            blend: self.blend,
+            resolution: self.mesh.resolution,
+            auto_resolution: !self.mesh.fixed_resolution,
+            options: self.mesh.options(),
+        })
+    }
+}
+
+pub fn run(a: &FillArgs, quiet: bool) -> Result<i32> {
+    a.mesh.check_report()?;
+    let report = execute(a, &latvox::progress::Progress::new(quiet))?;
+    let code = a.mesh.finish(&report, &report.part)?;
+    print_summary(&report);
+    Ok(code)
+}
+
+/// Runs the job and writes its mesh atomically; returns the report, for `run` to print and
+/// `latvox batch` to record.
+pub fn execute(a: &FillArgs, progress: &latvox::progress::Progress) -> Result<FillReport> {
+    let job = a.job()?;
+    latvox::io::atomic::check_writable(&a.mesh.output)?;
+    a.mesh.write(|sink| job.run_into(progress, sink), |r| &mut r.part)
+}
+
+fn print_summary(r: &FillReport) {
+    outln!(
+        "{} filled with {} · cells of {} mm · {} voxels/cell ({} mm)",
+        r.input,
+        r.lattice,
+        triple(r.cell_size),
+        r.resolution,
+        human(r.voxel_size, 4)
+    );
+    if !r.repair.is_empty() {
+        let changes: Vec<String> = r
+            .repair
+            .iter()
+            .map(|c| format!("{} {}", c.count, c.kind))
+            .collect();
+        outln!("repaired  {}", changes.join(", "));
+    }
+    outln!(
+        "regions   part {:.2} mm³ = skin{} {:.2} mm³ (skin {} mm) + fill {:.2} mm³",
+        r.part_volume,
+        if r.keep.is_empty() {
+            String::new()
+        } else {
+            format!(" and {} kept solid{}", r.keep.len(), if r.keep.len() == 1 { "" } else { "s" })
+        },
+        r.skin_volume,
+        human(r.skin, 4),
+        r.fill_volume
+    );
+    let p = &r.part;
+    outln!(
+        "density   of the fill: target {:.4}  achieved {:.4}  (error {:+.5}) · level {:.5}",
+        p.target_density.unwrap_or(f64::NAN),
+        p.achieved_density,
+        p.density_error.unwrap_or(f64::NAN),
+        r.level
+    );
+    print_part(p);
+}

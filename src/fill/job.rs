@@ -1,0 +1,449 @@
+//! One fill job, start to finish: close the part (latvox's repair, or a refusal naming what
+//! stays open), build its distance grid, measure the region the lattice fills (the whole part
+//! less the skin and the kept solids), find the lattice level at which the lattice fills that
+//! region to the target density — on the filled part itself, loose fragments removed — raising
+//! the resolution where the lattice or the skin is too thin for the voxels, then mesh, verify,
+//! write and report. The meshing is [`crate::mesh::pipeline`]'s, the resolution search
+//! [`crate::mesh::resolution`]'s.
+
+use super::shape::{FillFamily, FillSolid, Infill, Shape};
+use crate::check::Verdict;
+use crate::error::{Error, Result};
+use crate::field::{Aabb, Vec3};
+use crate::io::sink::{MeshCollector, MeshSink};
+use crate::mesh::pipeline::{self, Family, Measured, MeshingStats, Options, Route};
+use crate::mesh::report::{LevelSearch, PartReport, Timings};
+use crate::mesh::resolution::{self, Resolved};
+use crate::mesh::Mesh;
+use crate::progress::Progress;
+use crate::repair::{repair, Change, RepairOptions};
+use crate::strut::job::MIN_STRUT_VOXELS;
+use crate::strut::{RadiusModel, StrutFamily, StrutLattice, UnitCell};
+use crate::tpms::job::MIN_WALL_VOXELS;
+use crate::tpms::{calibrate, Lattice, LatticeFamily, Structure, Surface};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// A skin thinner than this many voxels is not represented faithfully (samples miss it and it
+/// perforates): the resolution is raised to keep it this thick.
+pub const MIN_SKIN_VOXELS: f64 = 2.0;
+
+/// The lattice that fills the part.
+#[derive(Debug, Clone)]
+pub enum Infilling {
+    /// A triply periodic minimal surface lattice.
+    Tpms {
+        /// Which surface.
+        surface: Surface,
+        /// Net or sheet.
+        structure: Structure,
+    },
+    /// A strut lattice.
+    Strut {
+        /// Its unit cell.
+        cell: Arc<UnitCell>,
+    },
+}
+
+/// What to build.
+#[derive(Debug, Clone)]
+pub struct FillJob {
+    /// The part: a closed triangle mesh (an open one is repaired first, or refused).
+    pub part: Mesh,
+    /// The part's name, for messages and the report (its file).
+    pub part_name: String,
+    /// Solids kept whole (bosses, flanges), with their names.
+    pub keep: Vec<(String, Mesh)>,
+    /// Skin thickness, mm (0: no skin, an open-cell part).
+    pub skin: f64,
+    /// The lattice.
+    pub lattice: Infilling,
+    /// Its name, for messages and the report.
+    pub lattice_name: String,
+    /// Cell size per axis, mm.
+    pub cell: Vec3,
+    /// The lattice's volume fraction in the region it fills, in (0, 1).
+    pub density: f64,
+    /// Radius of the smooth minimum joining the lattice to the skin (and struts at their
+    /// joints), mm.
+    pub blend: f64,
+    /// Voxels per cell along the cell's shortest axis.
+    pub resolution: u32,
+    /// Raise the resolution when the lattice or the skin would be too thin for the voxels.
+    pub auto_resolution: bool,
+    /// The pipeline's options.
+    pub options: Options,
+}
+
+/// The JSON report of a fill job.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct FillReport {
+    /// The part filled (its file).
+    pub input: String,
+    /// What latvox's repair changed to close the part (empty for a closed part).
+    pub repair: Vec<Change>,
+    /// The solids kept whole (their files).
+    pub keep: Vec<String>,
+    /// Skin thickness, mm (0: no skin).
+    pub skin: f64,
+    /// The lattice: a TPMS name or a strut cell.
+    pub lattice: String,
+    /// Net or sheet, for a TPMS lattice.
+    pub structure: Option<Structure>,
+    /// Cell size per axis, mm.
+    pub cell_size: Vec3,
+    /// The lattice's level: the TPMS level `t`, or the strut radius in mm.
+    pub level: f64,
+    /// Radius of the smooth minimum at the lattice's joins, mm.
+    pub blend: f64,
+    /// Volume of the whole part (and kept solids) meshed solid, mm³.
+    pub part_volume: f64,
+    /// Volume of the skin and kept solids alone, mm³.
+    pub skin_volume: f64,
+    /// Volume of the region the lattice fills (`part_volume − skin_volume`), mm³: the
+    /// density (`achieved_density`) is the lattice's share of it.
+    pub fill_volume: f64,
+    /// How the level was found (fractions of the fill region).
+    pub level_search: LevelSearch,
+    /// Voxels per cell asked for.
+    pub resolution_requested: u32,
+    /// Voxels per cell used.
+    pub resolution: u32,
+    /// Voxel edge, mm.
+    pub voxel_size: f64,
+    /// Memory of the part's distance grids, bytes.
+    pub distance_grid_bytes: u64,
+    /// The part as written: `target_density` and `achieved_density` are the lattice's share of
+    /// the fill region; mesh, checks, fragments (lattice pieces the part's surface cut loose,
+    /// removed), timings, warnings.
+    #[serde(flatten)]
+    pub part: PartReport,
+}
+
+impl FillReport {
+    /// The part's verdict.
+    pub fn verdict(&self) -> Verdict {
+        self.part.verdict()
+    }
+}
+
+/// A resolution at which the filled part reaches its density.
+struct Found<F: Family> {
+    voxel: f64,
+    route: Route,
+    family: FillFamily<F>,
+    best: Measured,
+    tried: Vec<(f64, f64)>,
+    meshing: MeshingStats,
+    grid_bytes: u64,
+}
+
+/// Closes `mesh` with latvox's repair, or refuses it naming what stays open.
+pub fn closed(mesh: &Mesh, name: &str) -> Result<(Mesh, Vec<Change>)> {
+    if mesh.triangle_count() == 0 {
+        return Err(Error::invalid(format!("{name}: no triangles")));
+    }
+    let (m, report) = repair(mesh, &RepairOptions::default(), &Progress::new(true))?;
+    if !report.open_shells.is_empty() || report.non_orientable_shells > 0 {
+        let edges: u64 = report.open_shells.iter().map(|s| s.boundary_edges).sum();
+        return Err(Error::invalid(format!(
+            "{name}: not a closed solid, and repair could not close it ({} open shell{}, {edges} boundary edges, {} one-sided shells); mend it with `latvox repair` or another tool first",
+            report.open_shells.len(),
+            if report.open_shells.len() == 1 { "" } else { "s" },
+            report.non_orientable_shells,
+        )));
+    }
+    if !(m.volume() > 0.0) {
+        return Err(Error::invalid(format!("{name}: encloses no volume")));
+    }
+    Ok((m, report.changes))
+}
+
+impl FillJob {
+    fn validate(&self) -> Result<()> {
+        if !(self.density > 0.0 && self.density < 1.0) {
+            return Err(Error::invalid(format!(
+                "density must be in (0, 1), got {}",
+                self.density
+            )));
+        }
+        if !(self.skin >= 0.0 && self.skin.is_finite()) {
+            return Err(Error::invalid(format!(
+                "skin must be a thickness ≥ 0 mm, got {}",
+                self.skin
+            )));
+        }
+        if !(self.blend >= 0.0 && self.blend.is_finite()) {
+            return Err(Error::invalid(format!(
+                "blend must be a length ≥ 0 mm, got {}",
+                self.blend
+            )));
+        }
+        if let Some(c) = self.cell.iter().find(|c| !(**c > 0.0 && c.is_finite())) {
+            return Err(Error::invalid(format!(
+                "cell size must be a positive length in mm, got {c}"
+            )));
+        }
+        if self.resolution < 4 {
+            return Err(Error::invalid(format!(
+                "resolution must be at least 4 voxels per cell, got {}",
+                self.resolution
+            )));
+        }
+        Ok(())
+    }
+
+    /// Runs the job and returns the mesh with its report.
+    pub fn run(&self, progress: &Progress) -> Result<(Mesh, FillReport)> {
+        let mut collector = MeshCollector::default();
+        let report = self.run_into(progress, &mut collector)?;
+        Ok((collector.mesh, report))
+    }
+
+    /// The shortest cell side, mm.
+    fn min_cell(&self) -> f64 {
+        self.cell.iter().cloned().fold(f64::INFINITY, f64::min)
+    }
+
+    /// Runs the job, streaming the filled part's triangles into `sink`.
+    pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<FillReport> {
+        let start = Instant::now();
+        self.validate()?;
+        let (part, changes) = {
+            let _p = progress.stage("checking the part is closed");
+            closed(&self.part, &self.part_name)?
+        };
+        let keep = self
+            .keep
+            .iter()
+            .map(|(name, m)| closed(m, name).map(|(m, _)| m))
+            .collect::<Result<Vec<_>>>()?;
+        match &self.lattice {
+            Infilling::Tpms { surface, structure } => {
+                let (s, st) = (*surface, *structure);
+                let t0 = calibrate::analytic_level(s, st, self.density);
+                let walls = (st == Structure::Sheet).then(|| {
+                    (
+                        calibrate::thinnest_sheet_wall(s, t0) * self.resolution as f64,
+                        MIN_WALL_VOXELS,
+                        "sheet walls",
+                    )
+                });
+                let make = |bounds: Aabb| LatticeFamily {
+                    part: Lattice {
+                        surface: s,
+                        structure: st,
+                        level: t0,
+                        cell: self.cell,
+                        bounds,
+                        phase: bounds.min,
+                    },
+                };
+                self.run_with(&part, &keep, changes, make, t0, walls, start, progress, sink)
+            }
+            Infilling::Strut { cell } => {
+                let model = Arc::new(RadiusModel::new(cell, self.cell));
+                let r0 = model.radius(self.density);
+                if r0 >= model.closing {
+                    return Err(Error::invalid(format!(
+                        "the {} lattice at density {} closes up: its pores close at radius {:.4} mm (density {:.3}), trapping powder or resin; give a lower density",
+                        self.lattice_name,
+                        self.density,
+                        model.closing,
+                        model.fraction(model.closing),
+                    )));
+                }
+                let factor = cell.radii.iter().cloned().fold(f64::INFINITY, f64::min);
+                let across =
+                    2.0 * r0 * factor * self.resolution as f64 / self.min_cell();
+                let make = |bounds: Aabb| StrutFamily {
+                    part: StrutLattice {
+                        cell: cell.clone(),
+                        size: self.cell,
+                        radius: r0,
+                        blend: self.blend,
+                        bounds,
+                        phase: bounds.min,
+                    },
+                    model: model.clone(),
+                };
+                self.run_with(
+                    &part,
+                    &keep,
+                    changes,
+                    make,
+                    r0,
+                    Some((across, MIN_STRUT_VOXELS, "struts")),
+                    start,
+                    progress,
+                    sink,
+                )
+            }
+        }
+    }
+
+    /// The resolution the lattice's members (`members`: their width in voxels at the requested
+    /// resolution, the least they need, and what they are) and the skin need, when the
+    /// requested one falls short, and why.
+    fn thin(&self, members: Option<(f64, f64, &str)>) -> Option<(u32, String)> {
+        let r = self.resolution;
+        let mut needs: Vec<(u32, String)> = Vec::new();
+        if let Some((w, min, what)) = members.filter(|(w, min, _)| w < min) {
+            needs.push((
+                (r as f64 * min / w).ceil() as u32,
+                format!("{what} were {w:.2} voxels across at {r} voxels per cell"),
+            ));
+        }
+        let skin_voxels = self.skin * r as f64 / self.min_cell();
+        if self.skin > 0.0 && skin_voxels < MIN_SKIN_VOXELS {
+            needs.push((
+                (r as f64 * MIN_SKIN_VOXELS / skin_voxels).ceil() as u32,
+                format!("the skin was {skin_voxels:.2} voxels thick at {r} voxels per cell"),
+            ));
+        }
+        needs.into_iter().max_by_key(|(n, _)| *n)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn run_with<F: Family>(
+        &self,
+        part: &Mesh,
+        keep: &[Mesh],
+        changes: Vec<Change>,
+        make: impl Fn(Aabb) -> F,
+        start_level: f64,
+        members: Option<(f64, f64, &str)>,
+        start: Instant,
+        progress: &Progress,
+        sink: &mut dyn MeshSink,
+    ) -> Result<FillReport>
+    where
+        F::Solid: Clone,
+    {
+        // The lattice's model (the strut radius model, the TPMS sample table) was made by now.
+        let model_seconds = start.elapsed().as_secs_f64();
+        let opts = &self.options;
+        let request = resolution::Request {
+            part: format!("the {} lattice filling {}", self.lattice_name, self.part_name),
+            setting: format!("density {}", self.density),
+            requested: self.resolution,
+            thin: self.thin(members),
+            density: Some(self.density),
+            auto: self.auto_resolution,
+        };
+        let resolved: Resolved<Found<F>> = resolution::search(&request, &mut |r| {
+            let voxel = self.min_cell() / r as f64;
+            let shape = {
+                let _p = progress.stage("building the part's distance field");
+                Arc::new(Shape::new(part, keep, voxel, self.skin + self.blend)?)
+            };
+            let lattice = make(shape.bounds);
+            let solid = |infill| FillSolid {
+                shape: shape.clone(),
+                skin: self.skin,
+                blend: self.blend,
+                infill,
+            };
+            let route = Route::choose(&solid(Infill::Full), voxel, opts);
+            let (whole, mut meshing) = {
+                let _p = progress.stage("measuring the part");
+                pipeline::solid_volume(&solid(Infill::Full), voxel, route)?
+            };
+            let base = if self.skin == 0.0 && keep.is_empty() {
+                0.0
+            } else {
+                let _p = progress.stage("measuring the skin");
+                let (v, m) = pipeline::solid_volume(&solid(Infill::Empty), voxel, route)?;
+                meshing.add(&m);
+                v
+            };
+            let fill = whole - base;
+            if !(fill > 1e-6 * whole) {
+                return Err(Error::invalid(format!(
+                    "a skin of {} mm leaves no room for a lattice in {}: it is thicker than half the part",
+                    self.skin, self.part_name
+                )));
+            }
+            let family = FillFamily {
+                lattice,
+                part: solid(Infill::Empty),
+                base_volume: base,
+                fill_volume: fill,
+            };
+            let solved = {
+                let _p = progress.stage(if r == self.resolution {
+                    "finding the lattice's level"
+                } else {
+                    "searching for a resolution that reaches the density"
+                });
+                pipeline::solve(&family, self.density, start_level, voxel, route, opts)?
+            };
+            if !solved.met {
+                return Ok(Err(solved.best.fraction));
+            }
+            meshing.add(&solved.meshing);
+            Ok(Ok(Found {
+                voxel,
+                route,
+                grid_bytes: shape.memory_bytes(),
+                family,
+                best: solved.best,
+                tried: solved.tried,
+                meshing,
+            }))
+        })?;
+        let Found {
+            voxel,
+            route,
+            family,
+            best,
+            tried,
+            meshing,
+            grid_bytes,
+        } = resolved.found;
+        let level = best.level;
+        let level_search = LevelSearch::new(&best, route, &tried, resolved.coarser);
+        let written = pipeline::write(&family, best, voxel, route, opts, progress, sink)?;
+        let bounds = family.part.shape.bounds;
+        let mut report = PartReport::new(
+            bounds,
+            None,
+            route,
+            written,
+            meshing,
+            Timings {
+                calibrate: model_seconds,
+                ..Timings::default()
+            },
+        );
+        let volume = report.volume.unwrap_or(f64::NAN);
+        report.density_against(self.density, family.fraction(volume, &bounds));
+        let mut warnings: Vec<String> = resolved.raised.into_iter().collect();
+        warnings.append(&mut report.warnings);
+        report.warnings = warnings;
+        report.timings.total = start.elapsed().as_secs_f64();
+        Ok(FillReport {
+            input: self.part_name.clone(),
+            repair: changes,
+            keep: self.keep.iter().map(|(n, _)| n.clone()).collect(),
+            skin: self.skin,
+            lattice: self.lattice_name.clone(),
+            structure: match &self.lattice {
+                Infilling::Tpms { structure, .. } => Some(*structure),
+                Infilling::Strut { .. } => None,
+            },
+            cell_size: self.cell,
+            level,
+            blend: self.blend,
+            part_volume: family.base_volume + family.fill_volume,
+            skin_volume: family.base_volume,
+            fill_volume: family.fill_volume,
+            level_search,
+            resolution_requested: self.resolution,
+            resolution: resolved.resolution,
+            voxel_size: voxel,
+            distance_grid_bytes: grid_bytes,
+            part: report,
+        })
+    }
+}

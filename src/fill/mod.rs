@@ -1,0 +1,10 @@
+//! Lattice-filled parts: a part's mesh kept as a solid skin, its core filled with any latvox
+//! lattice (TPMS or struts) at an exact density, solids kept whole where asked — one field
+//! ([`shape`]) through the meshing pipeline, one job ([`job`]) from the part's file to the
+//! verified mesh.
+
+pub mod job;
+pub mod shape;
+
+pub use job::{FillJob, FillReport, Infilling};
+pub use shape::{FillFamily, FillSolid, Infill, Shape};

@@ -1,0 +1,297 @@
+//! A part filled with a lattice, as a field: the part's signed distance (OpenVDB's
+//! meshToSignedDistanceField of its mesh, read trilinearly) combined with the lattice's.
+//!
+//! With `P` the part's distance (negative inside), `T` the skin thickness, `L` the lattice's
+//! field and `K` the union of the solids kept whole, the filled part is
+//!
+//! ```text
+//! F = min( max(P, S), K ),   S = smin(−P − T, L)   (S = L without a skin)
+//! ```
+//!
+//! `−P − T ≤ 0` is the skin (the part less its core, the points deeper than `T`); its union
+//! with the lattice, cut by the part, keeps the skin and the lattice inside the core; `smin` is
+//! the smooth minimum of radius `--blend` (a sharp union at 0) that fillets the lattice into the
+//! skin. The same field with no lattice (`S = −P − T`) is the skin alone, and with the part
+//! full (`F = min(P, K)`) the whole part: their volumes give the region the lattice fills, so
+//! the lattice's density is measured on it.
+
+use crate::error::Result;
+use crate::field::{smooth_min, Aabb, Field, Vec3};
+use crate::grid::{Grid, GridSpec};
+use crate::mesh::pipeline::{Family, Solid, HALF_WIDTH};
+use crate::mesh::Mesh;
+use std::sync::Arc;
+
+/// The trilinear interpolation of a distance field's samples changes by at most √3 per mm (each
+/// axis' slope is at most 1): a value's magnitude over this bounds the distance to its zero set.
+const TRILINEAR_LIPSCHITZ: f64 = 1.75;
+
+/// Voxels of exact distance kept beyond what the field reads (the band, the skin, the blend).
+const SPARE_VOXELS: f64 = 2.0;
+
+/// The part and the solids kept whole, as distance grids on one voxel size.
+pub struct Shape {
+    /// The part's signed distance.
+    part: Grid,
+    /// The solids kept whole.
+    keep: Vec<Grid>,
+    /// The box the filled part is meshed in: the part and the kept solids, grown by two voxels
+    /// so that it never clips them.
+    pub bounds: Aabb,
+    /// Voxel edge, mm.
+    pub voxel: f64,
+}
+
+impl Shape {
+    /// The distance grids of `part` and the solids `keep` at `voxel` mm, exact to `depth` mm
+    /// inside the part (the skin and the blend) and over the narrow band.
+    pub fn new(part: &Mesh, keep: &[Mesh], voxel: f64, depth: f64) -> Result<Shape> {
+        let exterior = HALF_WIDTH + SPARE_VOXELS;
+        let interior = depth / voxel + HALF_WIDTH + SPARE_VOXELS;
+        let grid = Grid::distance_to_mesh(part, voxel, exterior, interior)?;
+        let mut bounds = part.bounds().expect("a part has triangles");
+        let mut grids = Vec::with_capacity(keep.len());
+        for k in keep {
+            grids.push(Grid::distance_to_mesh(k, voxel, exterior, exterior)?);
+            let b = k.bounds().expect("a kept solid has triangles");
+            for a in 0..3 {
+                bounds.min[a] = bounds.min[a].min(b.min[a]);
+                bounds.max[a] = bounds.max[a].max(b.max[a]);
+            }
+        }
+        Ok(Shape {
+            part: grid,
+            keep: grids,
+            bounds: bounds.grown(2.0 * voxel),
+            voxel,
+        })
+    }
+
+    /// Memory of the distance grids, bytes (OpenVDB's count).
+    pub fn memory_bytes(&self) -> u64 {
+        self.part.memory_bytes() + self.keep.iter().map(Grid::memory_bytes).sum::<u64>()
+    }
+}
+
+/// What fills the part's core.
+#[derive(Debug, Clone)]
+pub enum Infill<S> {
+    /// Nothing: the skin (and the kept solids) alone.
+    Empty,
+    /// Solid: the whole part.
+    Full,
+    /// A lattice.
+    Lattice(S),
+}
+
+/// A part filled with a lattice, clipped by the shape's box.
+#[derive(Clone)]
+pub struct FillSolid<S> {
+    /// The part and the kept solids.
+    pub shape: Arc<Shape>,
+    /// Skin thickness, mm (0: no skin, the lattice cut by the part's surface).
+    pub skin: f64,
+    /// Radius of the smooth minimum joining the lattice to the skin, mm (0: a sharp union).
+    pub blend: f64,
+    /// What fills the core.
+    pub infill: Infill<S>,
+}
+
+impl<S: Solid + Clone> Solid for FillSolid<S> {
+    fn field(&self, spec: &GridSpec) -> Box<dyn Field + '_> {
+        Box::new(FillField {
+            solid: self,
+            lattice: match &self.infill {
+                Infill::Lattice(l) => Some(l.field(spec)),
+                _ => None,
+            },
+        })
+    }
+
+    fn bounds(&self) -> Aabb {
+        self.shape.bounds
+    }
+
+    fn with_bounds(&self, _: Aabb) -> Self {
+        // A filled part is never cut into templates (it has no period).
+        self.clone()
+    }
+
+    fn period(&self) -> Option<Vec3> {
+        None
+    }
+
+    fn snaps(&self) -> bool {
+        false
+    }
+}
+
+/// The field of a [`FillSolid`].
+struct FillField<'a, S> {
+    solid: &'a FillSolid<S>,
+    lattice: Option<Box<dyn Field + 'a>>,
+}
+
+/// The clearance of `max(a, b)`: its surface lies on `a`'s or `b`'s and inside both, so from
+/// outside either, that one's clearance alone bounds it.
+fn intersection_clearance(a: f64, ca: f64, b: f64, cb: f64) -> f64 {
+    let mut c = ca.min(cb);
+    if a > 0.0 {
+        c = c.max(ca);
+    }
+    if b > 0.0 {
+        c = c.max(cb);
+    }
+    c
+}
+
+/// The clearance of `min(a, b)`: its surface lies on `a`'s or `b`'s and outside both, so from
+/// inside either, that one's clearance alone bounds it.
+fn union_clearance(a: f64, ca: f64, b: f64, cb: f64) -> f64 {
+    intersection_clearance(-a, ca, -b, cb)
+}
+
+impl<S: Solid> FillField<'_, S> {
+    /// The filled part's value from the part's distance `p`, the lattice's value `l` and the
+    /// kept solids' distance `k`.
+    fn combine(&self, p: f64, l: f64, k: f64) -> f64 {
+        let s = self.solid;
+        let inner = match &s.infill {
+            Infill::Full => p,
+            Infill::Empty => p.max(-p - s.skin),
+            Infill::Lattice(_) if s.skin == 0.0 => p.max(l),
+            Infill::Lattice(_) if s.blend > 0.0 => p.max(smooth_min(-p - s.skin, l, s.blend)),
+            Infill::Lattice(_) => p.max((-p - s.skin).min(l)),
+        };
+        inner.min(k)
+    }
+
+    fn kept(&self, p: Vec3) -> f64 {
+        self.solid
+            .shape
+            .keep
+            .iter()
+            .map(|g| g.value_at(p))
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
+impl<S: Solid> Field for FillField<'_, S> {
+    fn value(&self, x: Vec3) -> f64 {
+        let p = self.solid.shape.part.value_at(x);
+        let l = self.lattice.as_ref().map_or(f64::INFINITY, |f| f.value(x));
+        self.combine(p, l, self.kept(x))
+    }
+
+    fn clearance(&self, x: Vec3) -> f64 {
+        let s = self.solid;
+        let p = s.shape.part.value_at(x);
+        let cp = p.abs() / TRILINEAR_LIPSCHITZ;
+        let inner = match &s.infill {
+            Infill::Full => cp,
+            Infill::Empty => {
+                let core = -p - s.skin;
+                intersection_clearance(p, cp, core, core.abs() / TRILINEAR_LIPSCHITZ)
+            }
+            Infill::Lattice(_) => {
+                let f = self.lattice.as_ref().expect("a lattice has a field");
+                let (l, cl) = (f.value(x), f.clearance(x));
+                let (sv, cs) = if s.skin == 0.0 {
+                    (l, cl)
+                } else {
+                    let core = -p - s.skin;
+                    let c = union_clearance(core, core.abs() / TRILINEAR_LIPSCHITZ, l, cl);
+                    // The smooth minimum moves the surface by up to its radius.
+                    if s.blend > 0.0 {
+                        (smooth_min(core, l, s.blend), (c - s.blend).max(0.0))
+                    } else {
+                        (core.min(l), c)
+                    }
+                };
+                intersection_clearance(p, cp, sv, cs)
+            }
+        };
+        if s.shape.keep.is_empty() {
+            return inner;
+        }
+        let k = self.kept(x);
+        // The inner value's sign, for the union's rule: that of the part as filled.
+        let v = self.combine(
+            p,
+            self.lattice.as_ref().map_or(f64::INFINITY, |f| f.value(x)),
+            f64::INFINITY,
+        );
+        union_clearance(v, inner, k, k.abs() / TRILINEAR_LIPSCHITZ)
+    }
+
+    fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
+        let mut points = [0.0f64; 3 * 512];
+        for i in 0..8 {
+            for j in 0..8 {
+                for k in 0..8 {
+                    let n = 3 * ((i * 8 + j) * 8 + k);
+                    points[n] = origin[0] + h * i as f64;
+                    points[n + 1] = origin[1] + h * j as f64;
+                    points[n + 2] = origin[2] + h * k as f64;
+                }
+            }
+        }
+        let mut part = [0.0f32; 512];
+        self.solid.shape.part.probe(&points, &mut part);
+        let mut lattice = [f32::INFINITY; 512];
+        if let Some(f) = &self.lattice {
+            f.sample_block(origin, h, &mut lattice);
+        }
+        let mut kept = [f32::INFINITY; 512];
+        let mut one = [0.0f32; 512];
+        for g in &self.solid.shape.keep {
+            g.probe(&points, &mut one);
+            for (k, o) in kept.iter_mut().zip(one.iter()) {
+                *k = k.min(*o);
+            }
+        }
+        for n in 0..512 {
+            out[n] = self.combine(part[n] as f64, lattice[n] as f64, kept[n] as f64) as f32;
+        }
+    }
+}
+
+/// A filled part at every lattice level: the lattice's family (`F`) inside the part, its
+/// density measured on the region the lattice fills.
+pub struct FillFamily<F: Family> {
+    /// The lattice's family, over the shape's box.
+    pub lattice: F,
+    /// The filled part at some level (the infill is replaced).
+    pub part: FillSolid<F::Solid>,
+    /// Volume of the part with nothing in its core (the skin and kept solids), mm³.
+    pub base_volume: f64,
+    /// Volume of the region the lattice fills (the whole part's less the base), mm³.
+    pub fill_volume: f64,
+}
+
+impl<F: Family> Family for FillFamily<F>
+where
+    F::Solid: Clone,
+{
+    type Solid = FillSolid<F::Solid>;
+
+    fn at(&self, level: f64) -> Self::Solid {
+        FillSolid {
+            infill: Infill::Lattice(self.lattice.at(level)),
+            ..self.part.clone()
+        }
+    }
+
+    fn model_fraction(&self, level: f64) -> f64 {
+        self.lattice.model_fraction(level)
+    }
+
+    fn model_level(&self, fraction: f64) -> f64 {
+        self.lattice.model_level(fraction)
+    }
+
+    /// The lattice's share of the region it fills.
+    fn fraction(&self, volume: f64, _: &Aabb) -> f64 {
+        (volume - self.base_volume) / self.fill_volume
+    }
+}
