@@ -65,7 +65,7 @@ enum Command {
     Batch(cli::batch::BatchArgs),
 }
 
-/// The command line with a part file's options put in (`--part`, for `tpms` and `strut`).
+/// The command line with a part file's options put in (`--part`, for `tpms`, `strut` and `fill`).
 fn expanded_args() -> latvox::Result<Vec<String>> {
     let argv: Vec<String> = std::env::args().collect();
     // The subcommand: the first word that is not a global option or its value.
@@ -78,7 +78,7 @@ fn expanded_args() -> latvox::Result<Vec<String>> {
         }
     }
     match argv.get(i).map(String::as_str) {
-        Some(command @ ("tpms" | "strut")) => {
+        Some(command @ ("tpms" | "strut" | "fill")) => {
             let tail = cli::part::expand(command, argv[i + 1..].to_vec())?;
             Ok([&argv[..=i], &tail[..]].concat())
         }

@@ -23,14 +23,7 @@ fn strut(dir: &Path, args: &[&str]) -> std::process::Output {
 fn assert_refused(dir: &Path, args: &[&str], what: &str) {
     let before = files_in(dir);
     let out = strut(dir, args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
-    assert!(
-        err.contains(what),
-        "{args:?}: '{err}' does not say '{what}'"
-    );
-    assert_eq!(files_in(dir), before, "{args:?} left a file");
+    assert_refusal(dir, &before, &out, args, what);
 }
 
 /// The volume fraction of a simple cubic lattice of struts of radius `r` along the edges of

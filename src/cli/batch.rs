@@ -10,6 +10,7 @@
 //! A subcommand joins the batch by implementing [`Task`] for its `Args` and adding one line to
 //! [`COMMANDS`].
 
+use super::fill::FillArgs;
 use super::out::outln;
 use super::repair::RepairArgs;
 use super::strut::StrutArgs;
@@ -56,8 +57,9 @@ Job file (paths relative to it; keys are the subcommand's long options):
   output = \"out/scan-fixed.stl\"
   drop-open-shells = true
 
-Jobs run the subcommands that make a part: tpms, strut, topo and repair, with the options of
-`latvox tpms`, `latvox strut`, `latvox topo` and `latvox repair` (`input` is the input file).
+Jobs run the subcommands that make a part: tpms, strut, fill, topo and repair, with the options
+of `latvox tpms`, `latvox strut`, `latvox fill`, `latvox topo` and `latvox repair` (`input` is
+the input file).
 
 Examples:
   latvox batch jobs.toml                       # run all jobs, 1 worker per thread
@@ -115,6 +117,7 @@ type ParseJob = fn(&'static str, &Job) -> std::result::Result<Box<dyn Task>, Str
 const COMMANDS: &[(&str, ParseJob)] = &[
     ("tpms", parse_job::<TpmsArgs>),
     ("strut", parse_job::<StrutArgs>),
+    ("fill", parse_job::<FillArgs>),
     ("topo", parse_job::<TopoArgs>),
     ("repair", parse_job::<RepairArgs>),
 ];
@@ -137,6 +140,17 @@ impl Task for StrutArgs {
 
     fn run(&self) -> Result<TaskReport> {
         super::strut::execute(self, &Progress::hidden())?.task_report()
+    }
+}
+
+impl Task for FillArgs {
+    fn outputs(&self) -> Vec<PathBuf> {
+        vec![self.mesh.output.clone()]
+    }
+
+    fn run(&self) -> Result<TaskReport> {
+        let r = super::fill::execute(self, &Progress::hidden())?;
+        TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
     }
 }
 
@@ -176,7 +190,7 @@ where
     let argv = command_line(&cmd, job)?;
     // A job may name a part file (`part = "octet.toml"`): its settings, the job's own first.
     let argv = match name {
-        "tpms" | "strut" => super::part::expand(name, argv).map_err(|e| e.to_string())?,
+        "tpms" | "strut" | "fill" => super::part::expand(name, argv).map_err(|e| e.to_string())?,
         _ => argv,
     };
     let matches = cmd.try_get_matches_from_mut(argv).map_err(clap_message)?;

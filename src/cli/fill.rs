@@ -1,7 +1,7 @@
 //! `latvox fill`: a part kept as a solid skin, its core filled with a lattice at an exact
 //! density, solids kept whole where asked.
 
-use super::lattice::{human, print_part, triple, MeshArgs};
+use super::lattice::{human, print_part, triple, MeshArgs, PartArgs};
 use super::out::outln;
 use super::tpms::parse_structure;
 use super::{parse_density, parse_length0, parse_positive3};
@@ -24,6 +24,10 @@ Examples:
   latvox fill grip.stl --lattice octet --cell-size 5 --density 0.15 --blend 0.3 \\
       --keep boss1.stl --keep boss2.stl -o grip-filled.stl --report grip.json
 
+  # Save the settings (the part's file by its absolute path), then fill it again finer
+  latvox fill bracket.stl --skin 1 --cell-size 4 -o filled.stl --save-part bracket.toml
+  latvox fill --part bracket.toml --resolution 48 -o filled-fine.stl
+
   # No skin: the part cut from a sheet gyroid, an open-cell part
   latvox fill implant.stl --no-skin --lattice gyroid --structure sheet --cell-size 3 \\
       --density 0.3 -o implant-open.stl
@@ -40,8 +44,11 @@ removed (counted in the summary and report), so the part is one piece; CGAL chec
 #[derive(Args)]
 pub struct FillArgs {
     /// The part to fill: a closed mesh (.stl, .obj, .off, .ply, .3mf).
-    #[arg(value_name = "PART")]
-    pub input: PathBuf,
+    #[arg(value_name = "PART", required_unless_present = "input_file")]
+    pub input: Option<PathBuf>,
+    /// The part to fill, as a part file gives it (the PART argument overrides it).
+    #[arg(long = "input", value_name = "PART", hide = true)]
+    pub input_file: Option<PathBuf>,
     /// Thickness of the solid skin kept inside the part's surface, mm.
     #[arg(long, value_name = "MM", default_value_t = 1.0, value_parser = parse_length0, allow_hyphen_values = true)]
     pub skin: f64,
@@ -71,6 +78,9 @@ pub struct FillArgs {
     /// Meshing and output.
     #[command(flatten)]
     pub mesh: MeshArgs,
+    /// Part files.
+    #[command(flatten)]
+    pub part_file: PartArgs,
 }
 
 /// Reads a mesh file for the job, naming it in errors.
@@ -109,7 +119,12 @@ impl FillArgs {
     /// The job the options describe.
     pub fn job(&self) -> Result<FillJob> {
         let (lattice, lattice_name) = self.infilling()?;
-        let (part_name, part) = read(&self.input)?;
+        let input = self
+            .input
+            .as_ref()
+            .or(self.input_file.as_ref())
+            .ok_or_else(|| Error::invalid("name the part to fill"))?;
+        let (part_name, part) = read(input)?;
         let keep = self
             .keep
             .iter()
@@ -145,7 +160,8 @@ pub fn run(a: &FillArgs, quiet: bool) -> Result<i32> {
 pub fn execute(a: &FillArgs, progress: &latvox::progress::Progress) -> Result<FillReport> {
     let job = a.job()?;
     latvox::io::atomic::check_writable(&a.mesh.output)?;
-    a.mesh.write(|sink| job.run_into(progress, sink), |r| &mut r.part)
+    a.mesh
+        .write(|sink| job.run_into(progress, sink), |r| &mut r.part)
 }
 
 fn print_summary(r: &FillReport) {
@@ -171,7 +187,11 @@ fn print_summary(r: &FillReport) {
         if r.keep.is_empty() {
             String::new()
         } else {
-            format!(" and {} kept solid{}", r.keep.len(), if r.keep.len() == 1 { "" } else { "s" })
+            format!(
+                " and {} kept solid{}",
+                r.keep.len(),
+                if r.keep.len() == 1 { "" } else { "s" }
+            )
         },
         r.skin_volume,
         human(r.skin, 4),

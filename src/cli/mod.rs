@@ -3,11 +3,11 @@
 
 pub mod batch;
 pub mod check;
+pub mod fill;
 pub mod lattice;
 pub(crate) mod out;
 pub mod part;
 pub mod repair;
-pub mod fill;
 pub mod strut;
 pub mod topo;
 pub mod topopt;

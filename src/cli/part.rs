@@ -1,4 +1,4 @@
-//! Part files: the settings that define a lattice part (`tpms` or `strut`), saved as TOML with
+//! Part files: the settings that define a lattice part (`tpms`, `strut` or `fill`), saved as TOML with
 //! `--save-part FILE.toml` and given back with `--part FILE.toml`, so that a part can be made
 //! again, varied, or handed to another tool.
 //!
@@ -17,7 +17,25 @@ use std::path::Path;
 const PART_KEYS: &[(&str, &[&str])] = &[
     ("tpms", &["type", "structure", "density", "allow-islands"]),
     ("strut", &["cell", "density", "radius", "blend"]),
+    (
+        "fill",
+        &[
+            "input",
+            "skin",
+            "no-skin",
+            "lattice",
+            "structure",
+            "cell-size",
+            "density",
+            "blend",
+            "keep",
+        ],
+    ),
 ];
+
+/// Options naming files that define the part (the mesh filled, the solids kept): saved as
+/// absolute paths, so that the part file makes the same part from any folder.
+const PATHS: &[&str] = &["input", "keep"];
 
 /// The options of the box and the meshing that define any lattice part.
 const COMMON: &[&str] = &[
@@ -56,15 +74,25 @@ pub fn save(
     let mut table = toml::Table::new();
     table.insert("command".into(), toml::Value::String(command.into()));
     for key in keys(command) {
-        let Some(arg) = cmd.get_arguments().find(|a| a.get_long() == Some(key)) else {
-            continue;
-        };
-        let Ok(raw) = matches.try_get_raw(arg.get_id().as_str()) else {
-            continue;
-        };
+        // The option, or an argument of that name (`fill`'s PART, also given as `--input`).
+        let raw = cmd
+            .get_arguments()
+            .filter(|a| a.get_long() == Some(key) || a.get_id().as_str() == key)
+            .find_map(|a| matches.try_get_raw(a.get_id().as_str()).ok().flatten());
         let Some(raw) = raw else { continue };
-        let raw: Vec<String> = raw.map(|v| v.to_string_lossy().into_owned()).collect();
+        let mut raw: Vec<String> = raw.map(|v| v.to_string_lossy().into_owned()).collect();
+        if PATHS.contains(&key) {
+            for v in raw.iter_mut() {
+                let p = Path::new(v.as_str());
+                let full = p.canonicalize().map_err(|e| Error::io(p, e))?;
+                *v = full.display().to_string();
+            }
+        }
         let value = match raw.as_slice() {
+            [v] if PATHS.contains(&key) => toml::Value::String(v.clone()),
+            _ if key == "keep" => {
+                toml::Value::Array(raw.iter().map(|v| toml::Value::String(v.clone())).collect())
+            }
             // A switch: kept only when on.
             [v] if v == "true" || v == "false" => {
                 if v == "false" {
@@ -151,7 +179,7 @@ pub fn expand(command: &str, argv: Vec<String>) -> Result<Vec<String>> {
         }
         None => {
             return Err(Error::invalid(format!(
-                "{}: a part file needs `command` (\"tpms\" or \"strut\")",
+                "{}: a part file needs `command` (\"tpms\", \"strut\" or \"fill\")",
                 path.display()
             )))
         }
@@ -204,6 +232,12 @@ pub fn expand(command: &str, argv: Vec<String>) -> Result<Vec<String>> {
             // A switch in the file: on when true.
             toml::Value::Boolean(true) => front.push(format!("--{key}")),
             toml::Value::Boolean(false) => {}
+            // A repeated option: once per item.
+            toml::Value::Array(items) if items.iter().all(toml::Value::is_str) => {
+                for item in items {
+                    front.push(format!("--{key}={}", item.as_str().unwrap_or_default()));
+                }
+            }
             _ => front.push(format!("--{key}={arg}")),
         }
     }

@@ -153,7 +153,8 @@ pub fn closed(mesh: &Mesh, name: &str) -> Result<(Mesh, Vec<Change>)> {
             report.non_orientable_shells,
         )));
     }
-    if !(m.volume() > 0.0) {
+    let volume = m.volume();
+    if volume.is_nan() || volume <= 0.0 {
         return Err(Error::invalid(format!("{name}: encloses no volume")));
     }
     Ok((m, report.changes))
@@ -239,7 +240,9 @@ impl FillJob {
                         phase: bounds.min,
                     },
                 };
-                self.run_with(&part, &keep, changes, make, t0, walls, start, progress, sink)
+                self.run_with(
+                    &part, &keep, changes, make, t0, walls, start, progress, sink,
+                )
             }
             Infilling::Strut { cell } => {
                 let model = Arc::new(RadiusModel::new(cell, self.cell));
@@ -254,8 +257,7 @@ impl FillJob {
                     )));
                 }
                 let factor = cell.radii.iter().cloned().fold(f64::INFINITY, f64::min);
-                let across =
-                    2.0 * r0 * factor * self.resolution as f64 / self.min_cell();
+                let across = 2.0 * r0 * factor * self.resolution as f64 / self.min_cell();
                 let make = |bounds: Aabb| StrutFamily {
                     part: StrutLattice {
                         cell: cell.clone(),
@@ -324,7 +326,10 @@ impl FillJob {
         let model_seconds = start.elapsed().as_secs_f64();
         let opts = &self.options;
         let request = resolution::Request {
-            part: format!("the {} lattice filling {}", self.lattice_name, self.part_name),
+            part: format!(
+                "the {} lattice filling {}",
+                self.lattice_name, self.part_name
+            ),
             setting: format!("density {}", self.density),
             requested: self.resolution,
             thin: self.thin(members),
@@ -358,7 +363,7 @@ impl FillJob {
                 v
             };
             let fill = whole - base;
-            if !(fill > 1e-6 * whole) {
+            if fill.is_nan() || fill <= 1e-6 * whole {
                 return Err(Error::invalid(format!(
                     "a skin of {} mm leaves no room for a lattice in {}: it is thicker than half the part",
                     self.skin, self.part_name

@@ -18,12 +18,7 @@ impl Grid {
     /// The signed distance to a triangle mesh at `voxel` mm, as [`Grid::from_mesh`], exact
     /// `exterior` voxels outside the surface and `interior` voxels inside it; beyond, the grid
     /// holds `±exterior·voxel` and `−interior·voxel` (lower bounds on the distance).
-    pub fn distance_to_mesh(
-        mesh: &Mesh,
-        voxel: f64,
-        exterior: f64,
-        interior: f64,
-    ) -> Result<Grid> {
+    pub fn distance_to_mesh(mesh: &Mesh, voxel: f64, exterior: f64, interior: f64) -> Result<Grid> {
         let inner = ffi::vdb_grid_from_mesh(
             &mesh.positions,
             &mesh.indices,

@@ -19,3 +19,43 @@ impl Grid {
         v[0] as f64
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::field::{Aabb, Field};
+    use crate::grid::{Grid, GridSpec};
+
+    /// A box's mesh as a distance grid, read between voxels: within a tenth of a voxel of the
+    /// box's exact distance inside the bands (at points off its faces: OpenVDB's mesh of the box
+    /// rounds its edges), and the bands' bounds beyond them.
+    #[test]
+    fn a_mesh_distance_reads_back_as_the_exact_distance() {
+        let b = Aabb {
+            min: [0.0; 3],
+            max: [4.0, 6.0, 8.0],
+        };
+        let spec = GridSpec::covering(&b.grown(1.0), 0.25, 3.0);
+        let mesh = Grid::sample(&b, spec).unwrap().to_mesh(0.0).unwrap();
+        let v = 0.2;
+        let g = Grid::distance_to_mesh(&mesh, v, 3.0, 8.0).unwrap();
+        for p in [
+            [2.0, 3.0, 4.0],
+            [1.03, 2.71, 0.4],
+            [3.9, 5.55, 7.1],
+            [-0.3, 3.3, 4.4],
+            [4.27, 3.0, 5.0],
+        ] {
+            let exact = b.value(p);
+            if exact.abs() < 2.5 * v || (exact < 0.0 && -exact < 7.5 * v) {
+                assert!(
+                    (g.value_at(p) - exact).abs() < 0.1 * v,
+                    "{p:?}: {} against {exact}",
+                    g.value_at(p)
+                );
+            }
+        }
+        // Deep inside: the interior band's bound; far outside: the exterior's.
+        assert!((g.value_at([2.0, 3.0, 4.0]) + 8.0 * v).abs() < 1e-4);
+        assert!((g.value_at([20.0, 3.0, 4.0]) - 3.0 * v).abs() < 1e-4);
+    }
+}

@@ -187,6 +187,19 @@ pub fn tpms(name: &str, p: [f64; 3], a: f64) -> (f64, [f64; 3]) {
     (f(p), g)
 }
 
+/// Asserts that `out` (a run with `args` in `dir`, whose files were `before`) is a refusal:
+/// exit 2, one line on stderr naming `what`, no file left behind.
+pub fn assert_refusal(dir: &Path, before: &[PathBuf], out: &Output, args: &[&str], what: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+    assert!(
+        err.contains(what),
+        "{args:?}: '{err}' does not say '{what}'"
+    );
+    assert_eq!(files_in(dir), before, "{args:?} left a file");
+}
+
 pub fn tempdir() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
 }
