@@ -7,60 +7,14 @@
 //! memory of N×N×N BCC cells (see [`scale`]).
 
 use latvox::field::Domain;
-use latvox::io::sink::{MeshFile, MeshSink, Triangle};
+use latvox::io::sink::MeshFile;
 use latvox::mesh::pipeline::Options;
 use latvox::progress::Progress;
 use latvox::strut::{Sizing, StrutJob, UnitCell};
 use std::sync::Arc;
 use std::time::Instant;
-
-/// The process's peak resident memory, MB (`VmHWM`).
-fn peak_rss_mb() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
-        })
-        .map_or(f64::NAN, |kb| kb / 1024.0)
-}
-
-/// Binary STL records made for every triangle (normal, corners, attribute: 50 bytes each) and
-/// dropped: the writing of a part too large for this machine's disk, without the disk.
-#[derive(Default)]
-struct DiscardedStl {
-    triangles: u64,
-    buf: Vec<u8>,
-}
-
-impl MeshSink for DiscardedStl {
-    fn begin(&mut self, _: Option<u64>) -> latvox::Result<()> {
-        Ok(())
-    }
-    fn triangles(&mut self, batch: &[Triangle]) -> latvox::Result<()> {
-        self.buf.clear();
-        for t in batch {
-            let u = [0, 1, 2].map(|a| t[1][a] - t[0][a]);
-            let v = [0, 1, 2].map(|a| t[2][a] - t[0][a]);
-            let n = [
-                u[1] * v[2] - u[2] * v[1],
-                u[2] * v[0] - u[0] * v[2],
-                u[0] * v[1] - u[1] * v[0],
-            ];
-            for x in n.iter().chain(t.iter().flatten()) {
-                self.buf.extend_from_slice(&x.to_le_bytes());
-            }
-            self.buf.extend_from_slice(&[0, 0]);
-        }
-        self.triangles += batch.len() as u64;
-        std::hint::black_box(&self.buf);
-        Ok(())
-    }
-    fn finish(&mut self) -> latvox::Result<()> {
-        Ok(())
-    }
-}
+mod support;
+use support::{peak_rss_mb, DiscardedStl};
 
 /// `--scale N`: N×N×N BCC cells of 5 mm, struts of radius 0.35 mm, 16 voxels per cell, copied
 /// from a template and streamed through STL records that are dropped (100³ cells would be a

@@ -26,8 +26,20 @@ use std::sync::Arc;
 /// axis' slope is at most 1): a value's magnitude over this bounds the distance to its zero set.
 const TRILINEAR_LIPSCHITZ: f64 = 1.75;
 
-/// Voxels of exact distance kept beyond what the field reads (the band, the skin, the blend).
-const SPARE_VOXELS: f64 = 2.0;
+/// A lower bound on the distance from a point to the zero set of a distance grid interpolated
+/// trilinearly, from the interpolated value `d` there, on voxels of `voxel` mm: `|d|/√3` (the
+/// interpolant's slope), or `|d| − √3·voxel` (the interpolant is within half a voxel diagonal
+/// of the true distance, which is 1-Lipschitz, at the point and on the zero set) — the samples
+/// being the distance where the grid is exact, a bound of the same sign beyond its bands.
+fn grid_clearance(d: f64, voxel: f64) -> f64 {
+    (d.abs() / TRILINEAR_LIPSCHITZ).max(d.abs() - TRILINEAR_LIPSCHITZ * voxel)
+}
+
+/// Voxels of exact distance kept beyond what the field reads (the band, the skin, the blend):
+/// enough that, beyond them, [`grid_clearance`] clears a whole leaf block and its band (a
+/// block's half diagonal, 3.5·√3 voxels, and the band's 3), so that the blocks wholly inside
+/// or outside the part are skipped, not sampled.
+const SPARE_VOXELS: f64 = 10.0;
 
 /// The part and the solids kept whole, as distance grids on one voxel size.
 pub struct Shape {
@@ -186,12 +198,13 @@ impl<S: Solid> Field for FillField<'_, S> {
     fn clearance(&self, x: Vec3) -> f64 {
         let s = self.solid;
         let p = s.shape.part.value_at(x);
-        let cp = p.abs() / TRILINEAR_LIPSCHITZ;
+        let h = s.shape.voxel;
+        let cp = grid_clearance(p, h);
         let inner = match &s.infill {
             Infill::Full => cp,
             Infill::Empty => {
                 let core = -p - s.skin;
-                intersection_clearance(p, cp, core, core.abs() / TRILINEAR_LIPSCHITZ)
+                intersection_clearance(p, cp, core, grid_clearance(core, h))
             }
             Infill::Lattice(_) => {
                 let f = self.lattice.as_ref().expect("a lattice has a field");
@@ -200,7 +213,7 @@ impl<S: Solid> Field for FillField<'_, S> {
                     (l, cl)
                 } else {
                     let core = -p - s.skin;
-                    let c = union_clearance(core, core.abs() / TRILINEAR_LIPSCHITZ, l, cl);
+                    let c = union_clearance(core, grid_clearance(core, h), l, cl);
                     // The smooth minimum moves the surface by up to its radius.
                     if s.blend > 0.0 {
                         (smooth_min(core, l, s.blend), (c - s.blend).max(0.0))
@@ -221,7 +234,7 @@ impl<S: Solid> Field for FillField<'_, S> {
             self.lattice.as_ref().map_or(f64::INFINITY, |f| f.value(x)),
             f64::INFINITY,
         );
-        union_clearance(v, inner, k, k.abs() / TRILINEAR_LIPSCHITZ)
+        union_clearance(v, inner, k, grid_clearance(k, h))
     }
 
     fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
