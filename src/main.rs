@@ -113,9 +113,14 @@ fn main() {
                 }
                 _ => {
                     let msg = e.to_string();
-                    let first = msg.lines().next().unwrap_or("invalid arguments").trim();
+                    let mut lines = msg.lines().map(str::trim).filter(|l| !l.is_empty());
+                    let first = lines.next().unwrap_or("invalid arguments");
                     let first = first.strip_prefix("error: ").unwrap_or(first);
-                    eprintln!("latvox: {first}");
+                    // "the following required arguments were not provided:" names them below.
+                    match lines.next().filter(|_| first.ends_with(':')) {
+                        Some(what) => eprintln!("latvox: {first} {what}"),
+                        None => eprintln!("latvox: {first}"),
+                    }
                     std::process::exit(2);
                 }
             }

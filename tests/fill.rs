@@ -297,6 +297,7 @@ fn bad_input_is_refused_in_one_line() {
     .unwrap();
     std::fs::write(d.join("broken.json"), b"{\"nodes\": [[0,0").unwrap();
     let cases: &[(&[&str], &str)] = &[
+        (&[], "<PART>"),
         (&["missing.stl"], "missing.stl"),
         (&["empty.stl"], "empty.stl"),
         (&["nofacets.stl"], "no facets"),
@@ -462,4 +463,36 @@ fn part_files_make_the_same_filled_part_again() {
         std::fs::read(d.join("first.stl")).unwrap() == std::fs::read(d.join("batch.stl")).unwrap(),
         "the batch job made another part"
     );
+}
+
+/// A skin under two voxels raises the resolution (with a warning saying why), or is refused
+/// with `--fixed-resolution`, naming the resolution that works.
+#[test]
+fn a_thin_skin_raises_the_resolution() {
+    let dir = tempdir();
+    let d = dir.path();
+    write_stl(&d.join("box.stl"), &box_tris([0.0; 3], [8.0; 3]));
+    let args = [
+        "box.stl",
+        "--skin",
+        "0.3",
+        "--lattice",
+        "gyroid",
+        "--cell-size",
+        "4",
+        "--resolution",
+        "12",
+    ];
+    let p = filled(d, &args);
+    // 0.3 mm at 12 voxels per 4 mm cell is 0.9 voxels: 2 voxels need 27 per cell, raised to
+    // whole 8-voxel blocks.
+    assert_eq!(p.report["resolution"], 32);
+    let warnings = p.report["warnings"].to_string();
+    assert!(
+        warnings.contains("the skin was 0.90 voxels thick"),
+        "{warnings}"
+    );
+    let mut fixed = args.to_vec();
+    fixed.push("--fixed-resolution");
+    assert_refused(d, &fixed, "--resolution 27");
 }
