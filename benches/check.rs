@@ -14,7 +14,6 @@
 
 use latvox::check::{check, CheckOptions};
 use latvox::io::{ReadOptions, StlFormat};
-use latvox::mesh::Mesh;
 use latvox::progress::Progress;
 use latvox::repair::{repair, RepairOptions};
 use std::process::Command;
@@ -54,35 +53,10 @@ fn time<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     (median(times), last.expect("at least one run"))
 }
 
+mod support;
+
 fn cpu() -> f64 {
     LAST_CPU.with(|l| l.get())
-}
-
-/// A torus (R = 40 mm, r = 15 mm) of `nu × nv` quads, wound outward.
-fn torus(nu: usize, nv: usize) -> Mesh {
-    let (big, small) = (40.0f64, 15.0f64);
-    let mut positions = Vec::with_capacity(3 * nu * nv);
-    for i in 0..nu {
-        let u = 2.0 * std::f64::consts::PI * i as f64 / nu as f64;
-        for j in 0..nv {
-            let v = 2.0 * std::f64::consts::PI * j as f64 / nv as f64;
-            let rr = big + small * v.cos();
-            positions.extend([
-                (rr * u.cos()) as f32,
-                (rr * u.sin()) as f32,
-                (small * v.sin()) as f32,
-            ]);
-        }
-    }
-    let id = |i: usize, j: usize| ((i % nu) * nv + (j % nv)) as u32;
-    let mut indices = Vec::with_capacity(6 * nu * nv);
-    for i in 0..nu {
-        for j in 0..nv {
-            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            indices.extend([a, b, c, a, c, d]);
-        }
-    }
-    Mesh { positions, indices }
 }
 
 fn main() {
@@ -99,7 +73,7 @@ fn main() {
     println!("machine: {threads} threads; {runs} runs per case, median reported");
     let dir = tempfile::tempdir().unwrap();
     let clean_path = dir.path().join("torus-1m.stl");
-    let clean = torus(1000, 500);
+    let clean = support::torus(40.0, 15.0, 1000, 500);
     assert_eq!(clean.triangle_count(), 1_000_000);
     assert!(clean.volume() > 0.0);
     latvox::io::stl::save(&clean, StlFormat::Binary, &clean_path).unwrap();

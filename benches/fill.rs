@@ -9,37 +9,11 @@
 
 use latvox::fill::{FillJob, Infilling};
 use latvox::mesh::pipeline::Options;
-use latvox::mesh::Mesh;
 use latvox::progress::Progress;
 use latvox::tpms::{Structure, Surface};
-use std::f64::consts::PI;
 use std::time::Instant;
 mod support;
-use support::{peak_rss_mb, DiscardedStl};
-
-/// A torus of radii `big` and `small` about the z axis, `nu × nv` quads, wound outward.
-fn torus(big: f64, small: f64, nu: usize, nv: usize) -> Mesh {
-    let mut positions = Vec::with_capacity(3 * nu * nv);
-    for i in 0..nu {
-        for j in 0..nv {
-            let (u, v) = (
-                2.0 * PI * i as f64 / nu as f64,
-                2.0 * PI * j as f64 / nv as f64,
-            );
-            let r = big + small * v.cos();
-            positions.extend([r * u.cos(), r * u.sin(), small * v.sin()].map(|x| x as f32));
-        }
-    }
-    let id = |i: usize, j: usize| ((i % nu) * nv + j % nv) as u32;
-    let mut indices = Vec::with_capacity(6 * nu * nv);
-    for i in 0..nu {
-        for j in 0..nv {
-            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            indices.extend([a, b, c, a, c, d]);
-        }
-    }
-    Mesh { positions, indices }
-}
+use support::{peak_rss_mb, torus, DiscardedStl};
 
 fn arg(args: &[String], name: &str, default: &str) -> String {
     args.iter()

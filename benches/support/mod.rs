@@ -1,8 +1,11 @@
-//! What the benchmarks share: the process's peak memory, and a sink that makes STL records
-//! and drops them (the writing of a part too large for this machine's disk, without the disk).
+//! What the benchmarks share: the process's peak memory, a sink that makes STL records and
+//! drops them (the writing of a part too large for this machine's disk, without the disk), and
+//! a torus mesh.
 #![allow(dead_code)]
 
 use latvox::io::sink::{MeshSink, Triangle};
+use latvox::mesh::Mesh;
+use std::f64::consts::PI;
 
 /// The process's peak resident memory, MB (`VmHWM`).
 pub fn peak_rss_mb() -> f64 {
@@ -50,4 +53,28 @@ impl MeshSink for DiscardedStl {
     fn finish(&mut self) -> latvox::Result<()> {
         Ok(())
     }
+}
+
+/// A torus of radii `big` and `small` mm about the z axis, `nu × nv` quads, wound outward.
+pub fn torus(big: f64, small: f64, nu: usize, nv: usize) -> Mesh {
+    let mut positions = Vec::with_capacity(3 * nu * nv);
+    for i in 0..nu {
+        for j in 0..nv {
+            let (u, v) = (
+                2.0 * PI * i as f64 / nu as f64,
+                2.0 * PI * j as f64 / nv as f64,
+            );
+            let r = big + small * v.cos();
+            positions.extend([r * u.cos(), r * u.sin(), small * v.sin()].map(|x| x as f32));
+        }
+    }
+    let id = |i: usize, j: usize| ((i % nu) * nv + j % nv) as u32;
+    let mut indices = Vec::with_capacity(6 * nu * nv);
+    for i in 0..nu {
+        for j in 0..nv {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            indices.extend([a, b, c, a, c, d]);
+        }
+    }
+    Mesh { positions, indices }
 }

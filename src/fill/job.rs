@@ -162,36 +162,20 @@ pub fn closed(mesh: &Mesh, name: &str) -> Result<(Mesh, Vec<Change>)> {
 
 impl FillJob {
     fn validate(&self) -> Result<()> {
-        if !(self.density > 0.0 && self.density < 1.0) {
-            return Err(Error::invalid(format!(
-                "density must be in (0, 1), got {}",
-                self.density
-            )));
-        }
+        resolution::check_density(self.density)?;
         if !(self.skin >= 0.0 && self.skin.is_finite()) {
             return Err(Error::invalid(format!(
                 "skin must be a thickness ≥ 0 mm, got {}",
                 self.skin
             )));
         }
-        if !(self.blend >= 0.0 && self.blend.is_finite()) {
-            return Err(Error::invalid(format!(
-                "blend must be a length ≥ 0 mm, got {}",
-                self.blend
-            )));
-        }
+        resolution::check_blend(self.blend)?;
         if let Some(c) = self.cell.iter().find(|c| !(**c > 0.0 && c.is_finite())) {
             return Err(Error::invalid(format!(
                 "cell size must be a positive length in mm, got {c}"
             )));
         }
-        if self.resolution < 4 {
-            return Err(Error::invalid(format!(
-                "resolution must be at least 4 voxels per cell, got {}",
-                self.resolution
-            )));
-        }
-        Ok(())
+        resolution::check_resolution(self.resolution)
     }
 
     /// Runs the job and returns the mesh with its report.

@@ -50,6 +50,36 @@ pub struct Resolved<T> {
     pub raised: Option<String>,
 }
 
+/// Refuses a volume fraction outside (0, 1).
+pub fn check_density(d: f64) -> Result<()> {
+    if d > 0.0 && d < 1.0 {
+        return Ok(());
+    }
+    Err(Error::invalid(format!(
+        "density must be in (0, 1), got {d}"
+    )))
+}
+
+/// Refuses a blend radius that is not a length ≥ 0.
+pub fn check_blend(blend: f64) -> Result<()> {
+    if blend >= 0.0 && blend.is_finite() {
+        return Ok(());
+    }
+    Err(Error::invalid(format!(
+        "blend must be a length ≥ 0 mm, got {blend}"
+    )))
+}
+
+/// Refuses fewer than 4 voxels per cell.
+pub fn check_resolution(resolution: u32) -> Result<()> {
+    if resolution >= 4 {
+        return Ok(());
+    }
+    Err(Error::invalid(format!(
+        "resolution must be at least 4 voxels per cell, got {resolution}"
+    )))
+}
+
 /// The finest resolution tried before a part is refused.
 pub fn max_resolution(requested: u32) -> u32 {
     (4 * requested).max(64)

@@ -175,11 +175,7 @@ struct Found {
 impl StrutJob {
     fn validate(&self) -> Result<()> {
         match self.sizing {
-            Sizing::Density(d) if !(d > 0.0 && d < 1.0) => {
-                return Err(Error::invalid(format!(
-                    "density must be in (0, 1), got {d}"
-                )))
-            }
+            Sizing::Density(d) => resolution::check_density(d)?,
             Sizing::Radius(r) if !(r > 0.0 && r.is_finite()) => {
                 return Err(Error::invalid(format!(
                     "radius must be a positive length in mm, got {r}"
@@ -187,19 +183,8 @@ impl StrutJob {
             }
             _ => {}
         }
-        if !(self.blend >= 0.0 && self.blend.is_finite()) {
-            return Err(Error::invalid(format!(
-                "blend must be a length ≥ 0 mm, got {}",
-                self.blend
-            )));
-        }
-        if self.resolution < 4 {
-            return Err(Error::invalid(format!(
-                "resolution must be at least 4 voxels per cell, got {}",
-                self.resolution
-            )));
-        }
-        Ok(())
+        resolution::check_blend(self.blend)?;
+        resolution::check_resolution(self.resolution)
     }
 
     /// Runs the job and returns the mesh with its report.

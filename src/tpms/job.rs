@@ -98,18 +98,8 @@ impl TpmsReport {
 
 impl TpmsJob {
     fn validate(&self) -> Result<()> {
-        if !(self.density > 0.0 && self.density < 1.0) {
-            return Err(Error::invalid(format!(
-                "density must be in (0, 1), got {}",
-                self.density
-            )));
-        }
-        if self.resolution < 4 {
-            return Err(Error::invalid(format!(
-                "resolution must be at least 4 voxels per cell, got {}",
-                self.resolution
-            )));
-        }
+        resolution::check_density(self.density)?;
+        resolution::check_resolution(self.resolution)?;
         if !(0.0..=1.0).contains(&self.adaptivity) {
             return Err(Error::invalid(format!(
                 "adaptivity must be in [0, 1], got {}",
