@@ -196,7 +196,7 @@ fn main() {
     });
     let c_whole = cpu();
     let (t_tiled, tiled) = time(runs, || {
-        latvox::check::self_intersect::soup_self_intersections(mesh, &all, None, 16).unwrap()
+        latvox::check::self_intersect::cgal_soup_self_intersections(mesh, &all, None, 16).unwrap()
     });
     let c_tiled = cpu();
     assert_eq!(whole, tiled);

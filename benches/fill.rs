@@ -45,7 +45,7 @@ fn main() {
         resolution,
         auto_resolution: false,
         options: Options {
-            self_intersection: true,
+            verify: latvox::check::verify::Verify::Full,
             instancing: false,
             memory: Some(memory),
             ..Default::default()

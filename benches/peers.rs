@@ -210,7 +210,7 @@ fn child(a: &[String]) {
                 adaptivity: 0.0,
                 allow_islands: false,
                 auto_resolution: true,
-                self_intersection: true,
+                verify: latvox::check::verify::Verify::Full,
                 instancing: true,
                 tile: None,
                 memory: None,

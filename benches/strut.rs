@@ -31,7 +31,7 @@ fn scale(n: u32) {
         resolution: 16,
         auto_resolution: false,
         options: Options {
-            self_intersection: true,
+            verify: latvox::check::verify::Verify::Full,
             instancing: true,
             ..Default::default()
         },
@@ -73,7 +73,7 @@ fn main() {
             resolution: 32,
             auto_resolution: true,
             options: Options {
-                self_intersection: true,
+                verify: latvox::check::verify::Verify::Full,
                 instancing: true,
                 ..Default::default()
             },

@@ -18,7 +18,7 @@ Exit codes (every command):
 #[command(
     name = "latvox",
     version,
-    about = "Sparse-volume voxel engine for additive manufacturing: TPMS and strut lattices and lattice-filled parts at exact density, verified by CGAL",
+    about = "Sparse-volume voxel engine for additive manufacturing: TPMS and strut lattices and lattice-filled parts at exact density, verified closed and free of self-intersections",
     long_about = None,
     after_help = EXIT_CODES
 )]

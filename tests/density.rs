@@ -18,7 +18,7 @@ fn every_type_and_structure_hits_its_target_within_0_002() {
                     adaptivity: 0.0,
                     allow_islands: true,
                     auto_resolution: true,
-                    self_intersection: false,
+                    verify: latvox::check::verify::Verify::Cgal,
                     instancing: true,
                     tile: None,
                     memory: None,

@@ -45,7 +45,7 @@ fn every_built_in_cell_meets_its_density_closed_and_in_one_piece() {
                 resolution: 32,
                 auto_resolution: false,
                 options: Options {
-                    self_intersection: true,
+                    verify: latvox::check::verify::Verify::Cgal,
                     instancing: true,
                     ..Default::default()
                 },

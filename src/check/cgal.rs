@@ -11,6 +11,8 @@ use crate::mesh::Mesh;
 /// What CGAL found.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Verification {
+    /// Who checked: `latvox` (its own exact checks), `CGAL`, or `nobody`.
+    pub checked_by: &'static str,
     /// The triangles formed an oriented 2-manifold as given (no non-manifold edge or vertex).
     pub manifold: bool,
     /// No boundary edge.
@@ -53,6 +55,7 @@ pub fn verify_on(mesh: &Mesh, self_intersection: bool, parallel: bool) -> Result
     let r = ffi::cgal_check(&mesh.positions, &mesh.indices, self_intersection, parallel)
         .backend("CGAL mesh check")?;
     Ok(Verification {
+        checked_by: "CGAL",
         manifold: r.valid_polygon_mesh,
         closed: r.closed,
         outward: r.outward,

@@ -15,6 +15,7 @@ pub mod cgal;
 mod file;
 pub mod self_intersect;
 pub(crate) mod verdict;
+pub mod verify;
 
 pub use file::{check_file, read_file, Defects, FileCheckReport};
 pub use verdict::Verdict;
@@ -751,16 +752,14 @@ pub fn check(
     let topo = Topology::new(mesh);
     let shells = Shells::new(mesh, &topo);
     let bad = FacetDefects::find(mesh, &topo);
-    let (flip, non_orientable) = orientation(mesh, &topo, &shells.of_facet, shells.count());
+    let (_, non_orientable) = orientation(mesh, &topo, &shells.of_facet, shells.count());
 
-    // CGAL's self-intersection search (the costliest check, building a CGAL mesh one facet at a
-    // time before its parallel search) runs alongside the rest of the check: it needs only the
-    // facets to leave out and the winding.
+    // The self-intersection search (the costliest check) runs alongside the rest of the check:
+    // it needs only the facets to leave out.
     let (si, found) = rayon::join(
         || {
             opts.self_intersections
-                .then(|| self_intersections(mesh, &topo, &bad, &flip))
-                .transpose()
+                .then(|| self_intersections(mesh, &topo, &bad))
         },
         || {
             let zero = &bad.zero_area;
@@ -775,7 +774,7 @@ pub fn check(
             )
         },
     );
-    let (self_intersections, examples) = match si? {
+    let (self_intersections, examples) = match si {
         Some((n, examples)) => (Some(n), examples),
         None => (None, Vec::new()),
     };
@@ -811,15 +810,9 @@ pub fn check(
     Ok(report)
 }
 
-/// Intersecting facet pairs (CGAL) among the facets that are neither degenerate nor duplicates;
-/// up to 16 of them as examples. `flip` winds the facets consistently, so CGAL can build its
-/// mesh as given.
-fn self_intersections(
-    mesh: &Mesh,
-    topo: &Topology,
-    bad: &FacetDefects,
-    flip: &[bool],
-) -> Result<(u64, Vec<(u32, u32)>)> {
+/// Intersecting facet pairs among the facets that are neither degenerate nor duplicates; up to 16
+/// of them as examples.
+fn self_intersections(mesh: &Mesh, topo: &Topology, bad: &FacetDefects) -> (u64, Vec<(u32, u32)>) {
     let nf = mesh.triangle_count();
     let mut is_dup = vec![false; nf];
     for &d in &bad.duplicates {
@@ -829,7 +822,7 @@ fn self_intersections(
     let keep: Vec<u32> = (0..nf as u32)
         .filter(|&f| topo.active[f as usize] && !zero[f as usize] && !is_dup[f as usize])
         .collect();
-    crate::check::self_intersect::soup_self_intersections(mesh, &keep, Some(flip), 16)
+    crate::check::self_intersect::soup_self_intersections(mesh, &keep, 16)
 }
 
 /// The shell of the facet that owns boundary half-edge a→b.

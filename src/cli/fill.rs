@@ -39,7 +39,8 @@ repair first, or refused when repair cannot close it. --density is the lattice's
 fraction in the region it fills (the part less its skin and the kept solids): latvox meshes the
 part solid and the skin alone to measure that region, then finds the lattice level at which the
 written mesh has the density. Lattice pieces the part's surface cuts loose from the rest are
-removed (counted in the summary and report), so the part is one piece; CGAL checks the mesh.";
+removed (counted in the summary and report), so the part is one piece; the whole written mesh
+is verified (--verify).";
 
 #[derive(Args)]
 pub struct FillArgs {

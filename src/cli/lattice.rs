@@ -7,6 +7,7 @@ use super::{
     parse_unit, write_json,
 };
 use clap::Args;
+use latvox::check::verify::Verify;
 use latvox::field::Domain;
 use latvox::io::sink::{MeshFile, MeshSink};
 use latvox::mesh::pipeline::Options;
@@ -88,14 +89,19 @@ pub struct MeshArgs {
     /// Write ASCII STL (or ASCII PLY) instead of binary.
     #[arg(long)]
     pub ascii: bool,
-    /// Write a JSON report (settings, densities, mesh counts, CGAL checks, timings).
+    /// Write a JSON report (settings, densities, mesh counts, checks, timings).
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
-    /// Skip CGAL's self-intersection test (the slowest check) on very large meshes.
-    #[arg(long)]
+    /// How the part is verified: full (closed, manifold, outward and no self-intersection, exact,
+    /// on the whole written part), fast (no self-intersection search), none, or cgal (CGAL's own
+    /// checks, an independent second opinion, several times slower)
+    #[arg(long, value_enum, default_value = "full", value_name = "HOW")]
+    pub verify: Verify,
+    /// The same as --verify fast.
+    #[arg(long, hide = true)]
     pub no_self_intersection_check: bool,
     /// Mesh the whole part at once instead of copying its periodic cells from a meshed
-    /// 3×3×3-cell template (slower, same solid; CGAL then checks the whole part).
+    /// 3×3×3-cell template (slower, same solid; the whole part is then verified).
     #[arg(long)]
     pub no_instancing: bool,
     /// Memory budget while meshing, e.g. 2G or 512M: a part whose grid would not fit is meshed
@@ -117,7 +123,11 @@ impl MeshArgs {
     pub fn options(&self) -> Options {
         Options {
             adaptivity: self.adaptivity,
-            self_intersection: !self.no_self_intersection_check,
+            verify: if self.no_self_intersection_check && self.verify == Verify::Full {
+                Verify::Fast
+            } else {
+                self.verify
+            },
             instancing: !self.no_instancing,
             tile: self.tile,
             memory: self.memory,
@@ -179,7 +189,7 @@ pub(crate) fn triple(v: [f64; 3]) -> String {
     }
 }
 
-/// The summary's lines on the part written: mesh, bounds, pieces, CGAL, time, file.
+/// The summary's lines on the part written: mesh, bounds, pieces, checks, time, file.
 pub(crate) fn print_part(r: &PartReport) {
     outln!(
         "mesh      {} triangles, {} vertices, area {:.2} mm², volume {:.2} mm³",
@@ -218,7 +228,11 @@ pub(crate) fn print_part(r: &PartReport) {
             ),
         }
     );
-    outln!("CGAL      {}", cgal_findings(&r.checks));
+    outln!(
+        "verified  {}  (by {})",
+        cgal_findings(&r.checks),
+        r.checks.checked_by
+    );
     let t = &r.timings;
     outln!(
         "time      {:.3} s (calibrate {:.3}, sample {:.3}, mesh {:.3}, snap {:.3}, verify {:.3}, write {:.3})",

@@ -148,7 +148,7 @@ pub(crate) fn emit_json(
     Ok(json)
 }
 
-/// CGAL's findings, as the summaries print them.
+/// The findings of a verification (latvox's or CGAL's), as the summaries print them.
 pub(crate) fn cgal_findings(c: &latvox::check::cgal::Verification) -> String {
     format!(
         "closed {}  outward {}  manifold {}  self-intersections {}",

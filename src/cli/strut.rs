@@ -39,7 +39,7 @@ Cells: sc (simple cubic), bcc, bccz (bcc with vertical struts), fcc, fccz, octet
        or a cell file (.json).
 A strut is a capsule (a cone with rounded ends where its two nodes' radius factors differ). With
 --density, latvox finds the radius at which the written mesh has that volume fraction; the
-report gives the radius, the fraction CGAL measures on the mesh, and CGAL's checks. Radii at
+report gives the radius, the fraction measured on the written mesh, and its checks. Radii at
 which struts would be under 2 voxels across raise the resolution; radii at which the pores
 between struts close are refused, with the range the cell allows.";
 

@@ -4,6 +4,7 @@
 use super::out::outln;
 use super::{cgal_findings, write_json};
 use clap::Args;
+use latvox::check::verify::Verify;
 use latvox::grid::Smoothing;
 use latvox::interpret::job;
 use latvox::interpret::{interpret_file, TopoFiles, TopoOptions, TopoPart};
@@ -36,7 +37,7 @@ point contacts are raised by 0.1, density-filtered (radius --filter-radius eleme
 re-thresholded at the level that keeps the thresholded volume, until none is left (at most
 --max-iterations passes). 2D results are extruded by --thickness; 3D results are meshed by
 OpenVDB (optionally smoothed with its level-set filter, --smooth), at the level that keeps the
-thresholded volume. Every mesh is checked by CGAL. The CAD curves (2D) are closed cubic
+thresholded volume. Every mesh is verified (closed, manifold, outward, no self-intersection). The CAD curves (2D) are closed cubic
 B-splines within --tolerance of the boundary, uniform and adaptive; the IGES and DXF files hold
 the adaptive ones.
 
@@ -112,8 +113,12 @@ pub struct TopoArgs {
     /// 3D: the smoothing flow.
     #[arg(long, value_enum, default_value = "gaussian")]
     pub smooth_filter: SmoothArg,
-    /// Skip CGAL's self-intersection test.
-    #[arg(long)]
+    /// How the 3D part is verified: full, fast (no self-intersection search), none, or cgal
+    /// (CGAL's own checks)
+    #[arg(long, value_enum, default_value = "full", value_name = "HOW")]
+    pub verify: Verify,
+    /// The same as --verify fast.
+    #[arg(long, hide = true)]
     pub no_self_intersection_check: bool,
 }
 
@@ -136,7 +141,11 @@ impl TopoArgs {
                 SmoothArg::Laplacian => Smoothing::Laplacian,
                 SmoothArg::Mean => Smoothing::Mean,
             },
-            self_intersection: !self.no_self_intersection_check,
+            verify: if self.no_self_intersection_check && self.verify == Verify::Full {
+                Verify::Fast
+            } else {
+                self.verify
+            },
         }
     }
 
@@ -214,9 +223,10 @@ fn summary(r: &job::TopoReport, a: &TopoArgs, images: &[PathBuf]) {
         100.0 * r.measure_change
     );
     outln!(
-        "mesh      {} triangles; CGAL {}",
+        "mesh      {} triangles; {} (verified by {})",
         r.triangles,
-        cgal_findings(&r.checks)
+        cgal_findings(&r.checks),
+        r.checks.checked_by
     );
     if !r.loops.is_empty() {
         outln!(

@@ -37,7 +37,8 @@ Types: p (Schwarz primitive), g|gyroid, d (Schwarz diamond), iwp (Schoen I-WP),
        s (Fischer–Koch S), frd (Schoen F-RD), n|neovius.
 Structures: net (solid on one side of F = t), sheet (solid where |F| ≤ t).
 The level t is found by latvox so that the written mesh has the requested volume fraction;
-the report gives the target, the fraction CGAL measures on the mesh, and the CGAL checks.";
+the report gives the target, the fraction measured on the written mesh, and its checks
+(--verify: closed, manifold, outward and no self-intersection by default).";
 
 #[derive(Args)]
 pub struct TpmsArgs {
@@ -100,7 +101,7 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
         adaptivity: o.adaptivity,
         allow_islands: a.allow_islands,
         auto_resolution: !m.fixed_resolution,
-        self_intersection: o.self_intersection,
+        verify: o.verify,
         instancing: o.instancing,
         tile: o.tile,
         memory: o.memory,

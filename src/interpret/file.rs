@@ -35,8 +35,8 @@ pub struct TopoOptions {
     pub smooth_iterations: u32,
     /// 3D: the smoothing flow.
     pub smoothing: Smoothing,
-    /// Run CGAL's self-intersection test (the costliest check).
-    pub self_intersection: bool,
+    /// How the 3D part is verified.
+    pub verify: crate::check::verify::Verify,
 }
 
 /// A 2D field refined by the default 8 pixels per element may have at most this many pixels.
@@ -85,7 +85,7 @@ impl TopoOptions {
             thickness: self.thickness.unwrap_or(self.element_size),
             tolerance,
             fit_curves: !d.is_3d,
-            self_intersection: self.self_intersection,
+            verify: self.verify,
             smooth_iterations: self.smooth_iterations,
             smoothing: self.smoothing,
         })

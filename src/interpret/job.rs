@@ -7,7 +7,7 @@ use super::contour::{self, Loop};
 use super::{extrude, volume, Density};
 use crate::cad::bspline::Periodic;
 use crate::cad::fit;
-use crate::check::cgal::{verify, Verification};
+use crate::check::cgal::Verification;
 use crate::check::Verdict;
 use crate::error::Result;
 use crate::grid::Smoothing;
@@ -27,8 +27,8 @@ pub struct TopoJob {
     pub tolerance: f64,
     /// Fit the CAD curves (2D only).
     pub fit_curves: bool,
-    /// Run CGAL's self-intersection test (the costliest check).
-    pub self_intersection: bool,
+    /// How the 3D part is verified.
+    pub verify: crate::check::verify::Verify,
     /// 3D: OpenVDB level-set smoothing passes (0: none) and the flow.
     pub smooth_iterations: u32,
     /// The level-set flow used for smoothing.
@@ -203,8 +203,8 @@ pub fn run(d: &Density, job: &TopoJob, progress: &Progress) -> Result<TopoResult
     timings.mesh = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let checks = {
-        let _s = progress.stage("verifying with CGAL");
-        verify(&mesh, job.self_intersection)?
+        let _s = progress.stage("verifying");
+        crate::check::verify::verify(&mesh, job.verify, progress)?
     };
     timings.verify = t.elapsed().as_secs_f64();
 

@@ -21,7 +21,8 @@
 //! [`solve`] says so with the closest fraction it found, and the caller raises the resolution
 //! or refuses.
 
-use crate::check::cgal::{verify, verify_on, Verification};
+use crate::check::cgal::Verification;
+use crate::check::verify::{verify, Verify};
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Field, Intersection, Vec3};
 use crate::grid::{Grid, GridSpec, IndexBox};
@@ -198,8 +199,8 @@ pub fn part_spec<S: Solid + ?Sized>(solid: &S, voxel: f64) -> GridSpec {
 pub struct Options {
     /// OpenVDB volumeToMesh adaptivity, 0 (uniform) to 1; above 0 the part is meshed whole.
     pub adaptivity: f64,
-    /// Run the self-intersection test (the costliest check).
-    pub self_intersection: bool,
+    /// How the written part is verified.
+    pub verify: Verify,
     /// Copy a periodic part's cells from a meshed template where possible.
     pub instancing: bool,
     /// Mesh in tiles of this many samples a side (a multiple of 8), whatever the part's size.
@@ -371,7 +372,14 @@ fn tiled_volume<S: Solid>(solid: &S, voxel: f64, edge: i64) -> Result<(f64, Mesh
         Ok(m)
     };
     let mut sink = VolumeSink;
-    let out = tile::mesh_tiled(spec.padded_region(), edge, &mesh_tile, false, &mut sink)?;
+    let out = tile::mesh_tiled(
+        spec.padded_region(),
+        edge,
+        &mesh_tile,
+        Verify::Fast,
+        &Progress::hidden(),
+        &mut sink,
+    )?;
     Ok((
         out.measures.volume,
         stats.into_inner().expect("no panic while holding the lock"),
@@ -532,8 +540,8 @@ pub struct Instancing {
     pub template_cells: [i64; 3],
     /// Triangles of the template.
     pub template_triangles: u64,
-    /// CGAL's checks ran on the template, which holds every kind of cell the part has; the
-    /// part is written as exact copies of its cells.
+    /// The checks ran on the template, which holds every kind of cell the part has; the part is
+    /// written as exact copies of its cells.
     pub verified: &'static str,
 }
 
@@ -546,7 +554,7 @@ pub struct Tiling {
     pub tile_samples: i64,
     /// Samples meshed around each tile and not kept.
     pub margin_samples: i64,
-    /// What was checked, and by whom: edges per tile by latvox, self-intersections by CGAL.
+    /// What was checked, and by whom.
     pub verified: &'static str,
 }
 
@@ -604,14 +612,18 @@ fn write_instanced(
     progress: &Progress,
     sink: &mut dyn MeshSink,
 ) -> Result<Written> {
-    // CGAL checks the template while the part is written: the two share the cores.
+    // The template is verified while the part is written: the two share the cores.
     let template_mesh = template.mesh.to_mesh();
     let (checks, verify_seconds, measures, write_seconds) = {
         let _p = progress.stage("writing the part and verifying its template");
         std::thread::scope(|scope| {
             let checker = scope.spawn(|| {
                 let t = Instant::now();
-                let r = verify_on(&template_mesh, o.self_intersection, false);
+                let r = match o.verify {
+                    // CGAL's parallel search would take the writer's core.
+                    Verify::Cgal => crate::check::cgal::verify_on(&template_mesh, true, false),
+                    v => verify(&template_mesh, v, &Progress::hidden()),
+                };
                 (r, t.elapsed().as_secs_f64())
             });
             let t = Instant::now();
@@ -673,7 +685,8 @@ fn write_tiled<S: Solid>(
             spec.padded_region(),
             edge,
             &mesh_tile,
-            o.self_intersection,
+            o.verify,
+            progress,
             sink,
         )?
     };
@@ -681,6 +694,7 @@ fn write_tiled<S: Solid>(
     let m = out.measures;
     Ok(Written {
         checks: Verification {
+            checked_by: o.verify.by(),
             manifold: closed,
             closed,
             outward: closed && m.volume > 0.0,
@@ -702,7 +716,12 @@ fn write_tiled<S: Solid>(
             tiles: out.tiles,
             tile_samples: edge,
             margin_samples: tile::MARGIN,
-            verified: "per tile: edges counted by latvox, self-intersection by CGAL",
+            verified: match o.verify {
+                Verify::Full => "every tile as written, seams included: edges and self-intersections by latvox",
+                Verify::Cgal => "every tile as written, seams included: edges by latvox, self-intersections by CGAL",
+                Verify::Fast => "every tile as written: edges by latvox; self-intersections not searched",
+                Verify::None => "not verified",
+            },
         }),
         verify_seconds: 0.0,
         write_seconds: t.elapsed().as_secs_f64(),
@@ -718,10 +737,7 @@ fn write_whole(
     sink: &mut dyn MeshSink,
 ) -> Result<Written> {
     let t = Instant::now();
-    let checks = {
-        let _p = progress.stage("verifying with CGAL");
-        verify(&mesh, o.self_intersection)?
-    };
+    let checks = { verify(&mesh, o.verify, progress)? };
     let verify_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let measures = {

@@ -14,10 +14,12 @@
 //! complete): every edge of a kept triangle must meet exactly one other triangle, running the other
 //! way, and CGAL's self-intersection test runs on the kept triangles with their neighbours.
 
+use crate::check::verify::Verify;
 use crate::error::Result;
 use crate::grid::IndexBox;
 use crate::io::sink::{Measures, MeshSink, Triangle};
 use crate::mesh::extract::KeyedMesh;
+use crate::progress::Progress;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -86,22 +88,24 @@ pub fn mesh_tiled(
     region: IndexBox,
     edge: i64,
     mesh_tile: &(dyn Fn(IndexBox) -> Result<KeyedMesh> + Sync),
-    self_intersection: bool,
+    verify: Verify,
+    progress: &Progress,
     sink: &mut dyn MeshSink,
 ) -> Result<TiledOutcome> {
     let all = tiles(region, edge);
     sink.begin(None)?;
     let mut out = TiledOutcome {
         tiles: all.len() as u64,
-        self_intersection_checked: self_intersection,
+        self_intersection_checked: verify.self_intersection(),
         ..Default::default()
     };
+    let counter = progress.counter(all.len() as u64, "tiles meshed, verified and written");
     for group in all.chunks(CONCURRENT_TILES) {
         let results: Vec<Result<TileResult>> = group
             .par_iter()
             .map(|own| {
                 let mesh = mesh_tile(own.grown(MARGIN))?;
-                tile_result(&mesh, own, self_intersection)
+                tile_result(&mesh, own, verify)
             })
             .collect();
         for r in results {
@@ -111,13 +115,14 @@ pub fn mesh_tiled(
             out.bad_edges += r.bad_edges;
             out.self_intersecting |= r.self_intersecting;
             sink.triangles(&r.triangles)?;
+            counter.inc();
         }
     }
     sink.finish()?;
     Ok(out)
 }
 
-fn tile_result(mesh: &KeyedMesh, own: &IndexBox, self_intersection: bool) -> Result<TileResult> {
+fn tile_result(mesh: &KeyedMesh, own: &IndexBox, verify: Verify) -> Result<TileResult> {
     let inside = |e: [i32; 3], m: i64| own.grown(m).contains(e.map(|x| x as i64));
     let kept: Vec<usize> = (0..mesh.quads.len())
         .filter(|&q| inside(mesh.edges[q], 0))
@@ -166,7 +171,7 @@ fn tile_result(mesh: &KeyedMesh, own: &IndexBox, self_intersection: bool) -> Res
 
     // Self-intersection: kept triangles (first) and every triangle close enough to touch one;
     // only pairs with a kept triangle count (the patch's own rim may be non-manifold).
-    let self_intersecting = if self_intersection && !kept.is_empty() {
+    let self_intersecting = if verify.self_intersection() && !kept.is_empty() {
         let around = (0..mesh.quads.len())
             .filter(|&q| !inside(mesh.edges[q], 0) && inside(mesh.edges[q], 3));
         let mut index = HashMap::new();
@@ -188,8 +193,16 @@ fn tile_result(mesh: &KeyedMesh, own: &IndexBox, self_intersection: bool) -> Res
             }
         }
         let all: Vec<u32> = (0..patch.triangle_count() as u32).collect();
-        let (_, pairs) =
-            crate::check::self_intersect::soup_self_intersections(&patch, &all, None, usize::MAX)?;
+        let (_, pairs) = if verify == Verify::Cgal {
+            crate::check::self_intersect::cgal_soup_self_intersections(
+                &patch,
+                &all,
+                None,
+                usize::MAX,
+            )?
+        } else {
+            crate::check::self_intersect::soup_self_intersections(&patch, &all, usize::MAX)
+        };
         pairs.iter().any(|&(f, g)| f.min(g) < kept_triangles)
     } else {
         false

@@ -39,8 +39,8 @@ pub struct TpmsJob {
     pub allow_islands: bool,
     /// Raise the resolution when sheet walls would be thinner than [`MIN_WALL_VOXELS`].
     pub auto_resolution: bool,
-    /// Run CGAL's self-intersection test (the costliest check).
-    pub self_intersection: bool,
+    /// How the written part is verified.
+    pub verify: crate::check::verify::Verify,
     /// Copy a periodic part's cells from a meshed template where possible ([`instance`]);
     /// otherwise the whole part is meshed at once.
     pub instancing: bool,
@@ -129,7 +129,7 @@ impl TpmsJob {
         let table_seconds = table_start.elapsed().as_secs_f64();
         let opts = Options {
             adaptivity: self.adaptivity,
-            self_intersection: self.self_intersection,
+            verify: self.verify,
             instancing: self.instancing,
             tile: self.tile,
             memory: self.memory,

@@ -1,22 +1,64 @@
-//! Self-intersections of any facet subset, by CGAL's box-intersection search on spatial tiles
-//! searched in parallel: the check that counts them and the repair that removes them both ask
-//! it.
+//! Self-intersections of any facet subset: which pairs of facets meet in more than the vertices
+//! and edge they share. latvox's own search ([`soup_self_intersections`]: a hierarchical grid
+//! broad phase, [`grid`], and CGAL's exact triangle tests ported onto Shewchuk's adaptive
+//! predicates, [`exact`]) answers the check, the repair and the verification of every mesh latvox
+//! writes; CGAL's box-intersection search on spatial tiles ([`cgal_soup_self_intersections`]) is
+//! kept as the independent oracle the tests compare it with.
+
+pub mod exact;
+mod grid;
 
 use crate::error::Result;
 use crate::ffi::cgal::ffi;
 use crate::ffi::Backend;
 use crate::mesh::Mesh;
+use crate::progress::Progress;
 use rayon::prelude::*;
 
-/// Counts intersecting pairs among the facets `keep` of `mesh` (which must have three distinct
-/// vertices each); returns the total and up to `limit` pairs as facet indices of `mesh`.
-/// `flip` (per facet of `mesh`), when given, reverses facets so neighbours agree: the answer does
-/// not depend on winding, but CGAL can then build its mesh directly instead of orienting a soup.
-/// Pairs come in ascending order of their positions in `keep`, the earlier facet first.
+/// Counts intersecting pairs among the facets `keep` of `mesh`; returns the total and up to
+/// `limit` pairs as facet indices of `mesh`, in ascending order of their positions in `keep`, the
+/// earlier facet first. Two facets intersect when their closed triangles meet anywhere but in
+/// the vertices and the edge they share (CGAL's definition in `self_intersections`, with sharing
+/// read off the vertex indices); a facet whose corners are collinear counts once, as a pair with
+/// itself; facets with the same three vertices are duplicates, not intersections.
+pub fn soup_self_intersections(mesh: &Mesh, keep: &[u32], limit: usize) -> (u64, Vec<(u32, u32)>) {
+    soup_self_intersections_shown(mesh, keep, limit, &Progress::hidden())
+}
+
+/// [`soup_self_intersections`] with a bar counting the blocks of the grid searched.
+pub fn soup_self_intersections_shown(
+    mesh: &Mesh,
+    keep: &[u32],
+    limit: usize,
+    progress: &Progress,
+) -> (u64, Vec<(u32, u32)>) {
+    let tris: Vec<[u32; 3]> = keep
+        .par_iter()
+        .map(|&f| {
+            let t = &mesh.indices[3 * f as usize..3 * f as usize + 3];
+            [t[0], t[1], t[2]]
+        })
+        .collect();
+    let pairs = grid::intersecting_pairs(&mesh.positions, &tris, progress);
+    let total = pairs.len() as u64;
+    let pairs = pairs
+        .into_iter()
+        .take(limit)
+        .map(|(a, b)| (keep[a as usize], keep[b as usize]))
+        .collect();
+    (total, pairs)
+}
+
+/// CGAL's count of intersecting pairs among the facets `keep` of `mesh` (which must have three
+/// distinct vertices each), and up to `limit` of them, as [`soup_self_intersections`] returns
+/// them. `flip` (per facet of `mesh`), when given, reverses facets so neighbours agree: the
+/// answer does not depend on winding, but CGAL can then build its mesh directly instead of
+/// orienting a soup (which pulls facets apart at non-manifold vertices: facets touching only
+/// there are not counted).
 ///
 /// The search runs on spatial tiles searched in parallel (see [`box_tiles`]), more of them the
 /// more threads there are; the answer is the same as one search of the whole soup.
-pub fn soup_self_intersections(
+pub fn cgal_soup_self_intersections(
     mesh: &Mesh,
     keep: &[u32],
     flip: Option<&[bool]>,
@@ -25,8 +67,8 @@ pub fn soup_self_intersections(
     soup_self_intersections_in_tiles(mesh, keep, flip, limit, tile_depth(keep.len()))
 }
 
-/// [`soup_self_intersections`] with a k-d split `depth` levels deep (`2^depth` tiles at most; 0
-/// searches the whole soup at once).
+/// [`cgal_soup_self_intersections`] with a k-d split `depth` levels deep (`2^depth` tiles at
+/// most; 0 searches the whole soup at once).
 pub fn soup_self_intersections_in_tiles(
     mesh: &Mesh,
     keep: &[u32],

@@ -1,0 +1,383 @@
+//! Verification of every mesh latvox writes, at meshing speed: closed, manifold, consistently
+//! wound and facing out, free of self-intersections, with its volume and area — read off the
+//! vertex indices in linear time (each vertex's fan of facets), and the exact self-intersection
+//! search of [`crate::check::self_intersect`]. CGAL's Polygon Mesh Processing checks remain
+//! available ([`Verify::Cgal`]) as an independent second opinion, and are the oracle the tests
+//! compare these checks with.
+
+use crate::check::cgal::Verification;
+use crate::error::Result;
+use crate::mesh::topology::UnionFind;
+use crate::mesh::Mesh;
+use crate::progress::Progress;
+use rayon::prelude::*;
+
+/// How a made part is verified.
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    clap::ValueEnum,
+    serde::Serialize,
+    serde::Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Verify {
+    /// Closed, manifold, outward, and no two facets intersecting (exact predicates): the whole
+    /// written part, whatever the route.
+    #[default]
+    Full,
+    /// Closed, manifold and outward, with volume and area; no self-intersection search.
+    Fast,
+    /// No checks.
+    None,
+    /// CGAL's own checks (Polygon Mesh Processing: closedness, orientation, self-intersection,
+    /// volume): an independent second opinion, several times slower.
+    Cgal,
+}
+
+impl Verify {
+    /// Whether self-intersections are searched for.
+    pub fn self_intersection(self) -> bool {
+        matches!(self, Verify::Full | Verify::Cgal)
+    }
+
+    /// Who checks, as reports name it.
+    pub fn by(self) -> &'static str {
+        match self {
+            Verify::Full | Verify::Fast => "latvox",
+            Verify::Cgal => "CGAL",
+            Verify::None => "nobody",
+        }
+    }
+}
+
+/// Verifies `mesh` as `how` asks; a bar counts the self-intersection search's progress.
+pub fn verify(mesh: &Mesh, how: Verify, progress: &Progress) -> Result<Verification> {
+    match how {
+        Verify::Cgal => crate::check::cgal::verify(mesh, true),
+        Verify::None => Ok(unchecked(mesh)),
+        Verify::Full | Verify::Fast => {
+            let (topo, si) = rayon::join(
+                || topology(mesh),
+                || {
+                    (how == Verify::Full).then(|| {
+                        let all: Vec<u32> = (0..mesh.triangle_count() as u32)
+                            .filter(|&f| !crate::mesh::topology::repeats_vertex(mesh, f as usize))
+                            .collect();
+                        crate::check::self_intersect::soup_self_intersections_shown(
+                            mesh, &all, 0, progress,
+                        )
+                        .0
+                    })
+                },
+            );
+            Ok(Verification {
+                checked_by: how.by(),
+                manifold: topo.manifold,
+                closed: topo.border_edges == 0 && topo.manifold,
+                outward: topo.outward,
+                self_intersection_checked: si.is_some(),
+                self_intersecting: si.is_some_and(|n| n > 0),
+                volume: (topo.border_edges == 0 && topo.manifold).then_some(topo.volume),
+                area: topo.area,
+                faces: mesh.triangle_count() as u64,
+                vertices: topo.vertices,
+                border_edges: topo.border_edges,
+                components: topo.components,
+            })
+        }
+    }
+}
+
+/// A verification that checked nothing (every property left unproven).
+fn unchecked(mesh: &Mesh) -> Verification {
+    Verification {
+        checked_by: Verify::None.by(),
+        manifold: false,
+        closed: false,
+        outward: false,
+        self_intersection_checked: false,
+        self_intersecting: false,
+        volume: None,
+        area: 0.0,
+        faces: mesh.triangle_count() as u64,
+        vertices: mesh.vertex_count() as u64,
+        border_edges: 0,
+        components: 0,
+    }
+}
+
+/// What the vertex fans say about a mesh.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fans {
+    /// Every facet has three distinct vertices; every edge is traversed at most once in each
+    /// direction and has at most two facets, traversed in opposite directions; every vertex's
+    /// facets form one fan (CGAL builds such a mesh as given).
+    pub manifold: bool,
+    /// Half-edges without a twin (edges with one facet).
+    pub border_edges: u64,
+    /// Closed, manifold, and facing out: the volume is positive, and every component enclosing
+    /// negative volume (a cavity) lies within the bounds of a larger positive one.
+    pub outward: bool,
+    /// Signed volume enclosed (divergence theorem), mm³.
+    pub volume: f64,
+    /// Surface area, mm².
+    pub area: f64,
+    /// Connected components (facets joined through shared vertices).
+    pub components: u64,
+    /// Vertices used by some facet.
+    pub vertices: u64,
+}
+
+/// The fans, volume, area and components of `mesh`, in time linear in its size: a counting sort
+/// of the corners by vertex, then each vertex on its own (in parallel) — the facets around it
+/// must chain into one cycle (or one path at a border), each edge from it met once in each
+/// direction.
+pub fn topology(mesh: &Mesh) -> Fans {
+    let nv = mesh.vertex_count();
+    let nf = mesh.triangle_count();
+    let idx = &mesh.indices;
+    let repeated = (0..nf)
+        .into_par_iter()
+        .any(|f| crate::mesh::topology::repeats_vertex(mesh, f));
+    // Corners (3f + k) by vertex.
+    let mut start = vec![0u32; nv + 1];
+    for &v in idx.iter() {
+        start[v as usize + 1] += 1;
+    }
+    for v in 0..nv {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start.clone();
+    let mut corners = vec![0u32; idx.len()];
+    for (c, &v) in idx.iter().enumerate() {
+        let s = &mut fill[v as usize];
+        corners[*s as usize] = c as u32;
+        *s += 1;
+    }
+    drop(fill);
+    // Each vertex: its link edges b → c (facet v, b, c in winding order).
+    const CHUNK: usize = 4096;
+    let (bad, border, used) = (0..nv.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|chunk| {
+            let mut link: Vec<(u32, u32)> = Vec::new();
+            let (mut bad, mut border, mut used) = (false, 0u64, 0u64);
+            for v in chunk * CHUNK..((chunk + 1) * CHUNK).min(nv) {
+                let cs = &corners[start[v] as usize..start[v + 1] as usize];
+                if cs.is_empty() {
+                    continue;
+                }
+                used += 1;
+                link.clear();
+                link.extend(cs.iter().map(|&c| {
+                    let (f, k) = (c as usize / 3, c as usize % 3);
+                    (idx[3 * f + (k + 1) % 3], idx[3 * f + (k + 2) % 3])
+                }));
+                let (b_fan, b_border) = fan(&link);
+                bad |= b_fan;
+                border += b_border;
+            }
+            (bad, border, used)
+        })
+        .reduce(|| (false, 0, 0), |x, y| (x.0 || y.0, x.1 + y.1, x.2 + y.2));
+    let manifold = !repeated && !bad;
+
+    // Components through shared vertices; volume and area per component.
+    let mut uf = UnionFind::new(nv);
+    for t in idx.chunks_exact(3) {
+        uf.union(t[0], t[1]);
+        uf.union(t[0], t[2]);
+    }
+    let root: Vec<u32> = (0..nv as u32).map(|v| uf.find(v)).collect();
+    let mut comp = vec![u32::MAX; nv];
+    let mut components = 0u32;
+    for v in 0..nv {
+        if start[v + 1] > start[v] {
+            let r = root[v] as usize;
+            if comp[r] == u32::MAX {
+                comp[r] = components;
+                components += 1;
+            }
+        }
+    }
+    // Positions from a point of the mesh, so that far-off parts lose no precision.
+    let o = if nv > 0 {
+        [0, 1, 2].map(|i| mesh.positions[i] as f64)
+    } else {
+        [0.0; 3]
+    };
+    let p = |v: u32| {
+        let i = 3 * v as usize;
+        [
+            mesh.positions[i] as f64 - o[0],
+            mesh.positions[i + 1] as f64 - o[1],
+            mesh.positions[i + 2] as f64 - o[2],
+        ]
+    };
+    let nc = components as usize;
+    let (vols, area, lo, hi) = idx
+        .par_chunks_exact(3)
+        .fold(
+            || {
+                (
+                    vec![0.0f64; nc],
+                    0.0f64,
+                    vec![[f64::INFINITY; 3]; nc],
+                    vec![[f64::NEG_INFINITY; 3]; nc],
+                )
+            },
+            |(mut vols, mut area, mut lo, mut hi), t| {
+                let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+                let k = comp[root[t[0] as usize] as usize] as usize;
+                let cr = cross(sub(b, a), sub(c, a));
+                vols[k] += dot(a, cross(b, c)) / 6.0;
+                area += 0.5 * dot(cr, cr).sqrt();
+                for q in [a, b, c] {
+                    for i in 0..3 {
+                        lo[k][i] = lo[k][i].min(q[i]);
+                        hi[k][i] = hi[k][i].max(q[i]);
+                    }
+                }
+                (vols, area, lo, hi)
+            },
+        )
+        .reduce(
+            || {
+                (
+                    vec![0.0f64; nc],
+                    0.0f64,
+                    vec![[f64::INFINITY; 3]; nc],
+                    vec![[f64::NEG_INFINITY; 3]; nc],
+                )
+            },
+            |mut x, y| {
+                for k in 0..nc {
+                    x.0[k] += y.0[k];
+                    for i in 0..3 {
+                        x.2[k][i] = x.2[k][i].min(y.2[k][i]);
+                        x.3[k][i] = x.3[k][i].max(y.3[k][i]);
+                    }
+                }
+                x.1 += y.1;
+                x
+            },
+        );
+    let volume: f64 = vols.iter().sum();
+    let inside = |k: usize, j: usize| (0..3).all(|i| lo[j][i] <= lo[k][i] && hi[k][i] <= hi[j][i]);
+    let cavities_enclosed = (0..nc)
+        .filter(|&k| vols[k] < 0.0)
+        .all(|k| (0..nc).any(|j| vols[j] > 0.0 && vols[j] > -vols[k] && inside(k, j)));
+    Fans {
+        manifold,
+        border_edges: border,
+        outward: manifold && border == 0 && volume > 0.0 && cavities_enclosed,
+        volume,
+        area,
+        components: components as u64,
+        vertices: used,
+    }
+}
+
+/// Checks one vertex's link edges `b → c`: returns (defective, border half-edges). The fan is
+/// sound when no vertex starts two link edges or ends two (each edge from the vertex traversed
+/// once each way), and the link edges chain into one cycle, or one path where the fan meets a
+/// border. A half-edge v → b without its twin b → v is a border half-edge (the link edge that
+/// starts at b has no link edge ending at b).
+fn fan(link: &[(u32, u32)]) -> (bool, u64) {
+    let n = link.len();
+    let starts_at = |x: u32| link.iter().filter(|e| e.0 == x).count();
+    let ends_at = |x: u32| link.iter().filter(|e| e.1 == x).count();
+    let mut border = 0u64;
+    let mut bad = false;
+    let mut path_start = None;
+    for &(b, c) in link {
+        if starts_at(b) != 1 || ends_at(c) != 1 {
+            bad = true;
+        }
+        if ends_at(b) == 0 {
+            border += 1;
+            if path_start.replace(b).is_some() {
+                bad = true; // two border paths meet here
+            }
+        }
+    }
+    if bad {
+        return (true, border);
+    }
+    // Walk the chain from the path's start (or anywhere on a cycle); it must cover every facet.
+    let first = path_start.unwrap_or(link[0].0);
+    let mut at = first;
+    let mut steps = 0;
+    while let Some(&(_, c)) = link.iter().find(|e| e.0 == at) {
+        steps += 1;
+        at = c;
+        if at == first || steps > n {
+            break;
+        }
+    }
+    (steps != n, border)
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tetra() -> Mesh {
+        Mesh {
+            positions: vec![0., 0., 0., 1., 0., 0., 0., 1., 0., 0., 0., 1.],
+            indices: vec![0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2],
+        }
+    }
+
+    #[test]
+    fn a_tetrahedron_is_a_closed_outward_solid() {
+        let t = topology(&tetra());
+        assert!(t.manifold && t.outward, "{t:?}");
+        assert_eq!(t.border_edges, 0);
+        assert!((t.volume - 1.0 / 6.0).abs() < 1e-12);
+        assert_eq!(t.components, 1);
+    }
+
+    #[test]
+    fn holes_flips_and_fins_are_found() {
+        let mut open = tetra();
+        open.indices.truncate(9);
+        let t = topology(&open);
+        assert!(t.manifold && !t.outward);
+        assert_eq!(t.border_edges, 3);
+        let mut flipped = tetra();
+        flipped.indices.swap(0, 1);
+        assert!(!topology(&flipped).manifold);
+        let mut inward = tetra();
+        for f in inward.indices.chunks_exact_mut(3) {
+            f.swap(1, 2);
+        }
+        let t = topology(&inward);
+        assert!(t.manifold && !t.outward && t.volume < 0.0);
+        let mut fin = tetra();
+        fin.positions.extend_from_slice(&[1., 1., 1.]);
+        fin.indices.extend_from_slice(&[0, 1, 4]);
+        assert!(!topology(&fin).manifold);
+    }
+}
