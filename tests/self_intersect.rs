@@ -188,6 +188,23 @@ fn planted_defects_are_found_as_cgal_finds_them() {
     assert_eq!(same_pairs_as_cgal(&welded(&tee_off), "lifted"), 0);
 }
 
+/// Facets of widely different sizes (a coarse box crossed by a fine sphere, and long slivers
+/// through it): the coarse facets sit on coarser levels of the grid, and every pair is still
+/// found.
+#[test]
+fn facets_of_widely_varying_size_give_cgal_pairs() {
+    let mut tris = cuboid([0.0; 3], [20.0, 20.0, 20.0]);
+    let ball: Vec<Tri> = meshkit::sphere(1.5, 40)
+        .iter()
+        .map(|t| t.map(|p| [p[0] + 20.0, p[1] + 10.0, p[2] + 10.0]))
+        .collect();
+    tris.extend(ball);
+    // A long sliver from corner to corner, crossing the sphere's region.
+    tris.push([[0.5, 0.5, 0.5], [19.5, 19.5, 19.0], [19.5, 19.4, 19.5]]);
+    let mesh = welded(&tris);
+    assert!(same_pairs_as_cgal(&mesh, "box, sphere and sliver") > 0);
+}
+
 /// Random triangles on a small integer grid (so that touching, collinear and coplanar cases
 /// are common), every facet with its own vertices: the pure geometric test, exactly as CGAL's.
 #[test]

@@ -309,7 +309,8 @@ fn random_settings_meet_their_density_or_are_refused() {
             &origin,
             "-r",
             &res,
-            "--no-self-intersection-check",
+            "--verify",
+            "fast",
         ];
         let ctx = format!("case {case}: {}", args.join(" "));
         let out = strut(d, &args);

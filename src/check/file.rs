@@ -48,7 +48,8 @@ pub struct FileCheckReport {
     pub check: CheckReport,
     /// The defect classes found, with their counts.
     pub defects: Defects,
-    /// CGAL's checks (its self-intersection finding is the one `check` made).
+    /// CGAL's checks: closedness, orientation and volume by CGAL (a second opinion on latvox's
+    /// counts); the self-intersection finding is the one latvox's exact search made.
     pub cgal: Verification,
 }
 
@@ -79,8 +80,8 @@ pub fn check_file(
         )
     };
     let (report, mut cgal) = (report?, cgal?);
-    // The check above already ran CGAL's self-intersection test (on the facets that are neither
-    // degenerate nor duplicate); it is not run twice.
+    // The check above already searched for self-intersections (on the facets that are neither
+    // degenerate nor duplicate, with CGAL's exact triangle tests); it is not run twice.
     cgal.self_intersection_checked = report.self_intersections.is_some();
     cgal.self_intersecting = report.self_intersections.unwrap_or(0) > 0;
     Ok(FileCheckReport {

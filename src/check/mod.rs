@@ -38,7 +38,7 @@ pub const T_JUNCTION_REL: f64 = 1e-6;
 /// What to check.
 #[derive(Debug, Clone, Copy)]
 pub struct CheckOptions {
-    /// Run CGAL's self-intersection test (the costliest check).
+    /// Search for self-intersections (the costliest check).
     pub self_intersections: bool,
     /// Also treat vertices within this distance (mm) of an edge as lying on it.
     pub tolerance: f64,
@@ -707,7 +707,7 @@ fn normal_report(mesh: &Mesh, topo: &Topology, zero: &[bool], ns: &[[f32; 3]]) -
     r
 }
 
-/// What the check finds besides CGAL's self-intersections (it runs alongside their search).
+/// What the check finds besides self-intersections (it runs alongside their search).
 struct Findings {
     shells: Vec<ShellReport>,
     inward_shells: u64,

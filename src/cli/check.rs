@@ -20,7 +20,8 @@ Reads STL (binary or ASCII), OBJ, OFF, PLY (ASCII or binary) and 3MF. Counts fac
 edges and shells (each with volume, area, Euler characteristic and genus); boundary edges and
 hole loops; non-manifold edges and vertices; stored normals that disagree with the winding;
 inconsistently wound neighbours; inward-facing shells; degenerate and duplicate facets;
-T-junctions; and self-intersecting facet pairs (CGAL).
+T-junctions; and self-intersecting facet pairs (exact, with CGAL's triangle tests). CGAL checks
+closedness, orientation and volume beside latvox, as a second opinion.
 
 Exit code 0 when the mesh is a valid closed, outward, self-intersection-free solid; 1 when
 defects are found; 2 when the file cannot be read.";
@@ -45,7 +46,7 @@ pub struct CheckFlags {
     /// Merge vertices closer than this (mm) when reading; exact matches are always merged.
     #[arg(long, value_name = "MM", default_value_t = 0.0, value_parser = super::parse_length0)]
     pub weld_tolerance: f64,
-    /// Skip CGAL's self-intersection test (the costliest check).
+    /// Skip the self-intersection search (the costliest check).
     #[arg(long)]
     pub no_self_intersection: bool,
 }

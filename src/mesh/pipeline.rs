@@ -736,24 +736,30 @@ fn write_whole(
     progress: &Progress,
     sink: &mut dyn MeshSink,
 ) -> Result<Written> {
-    let t = Instant::now();
-    let checks = { verify(&mesh, o.verify, progress)? };
-    let verify_seconds = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let measures = {
-        let _p = progress.stage("writing the part");
-        write_mesh(&mesh, sink)?
-    };
+    // The part is verified while it is written: the search is on the cores, the writing mostly
+    // on the disk.
+    let (checks, verify_seconds, measures, write_seconds) = std::thread::scope(|scope| {
+        let checker = scope.spawn(|| {
+            let t = Instant::now();
+            let r = verify(&mesh, o.verify, progress);
+            (r, t.elapsed().as_secs_f64())
+        });
+        let t = Instant::now();
+        let measures = write_mesh(&mesh, sink);
+        let write_seconds = t.elapsed().as_secs_f64();
+        let (checks, verify_seconds) = checker.join().expect("the verification does not panic");
+        (checks, verify_seconds, measures, write_seconds)
+    });
     Ok(Written {
-        checks,
+        checks: checks?,
         meshing,
-        measures,
+        measures: measures?,
         vertices: mesh.vertex_count() as u64,
         fragments,
         instancing: None,
         tiling: None,
         verify_seconds,
-        write_seconds: t.elapsed().as_secs_f64(),
+        write_seconds,
     })
 }
 

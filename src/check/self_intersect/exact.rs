@@ -416,6 +416,12 @@ fn coplanar_segment_meets_triangle(aa: &P, bb: &P, cc: &P, p: &P, q: &P) -> bool
 /// sharing all three vertices (duplicates) are not counted here: `check` reports them as
 /// duplicate facets.
 pub fn facets_intersect(f: &Facet, g: &Facet) -> bool {
+    facets_intersect_beside(f, g, |_| false)
+}
+
+/// [`facets_intersect`], told which vertices are known to hold no intersecting pair of facets
+/// sharing only them (see [`super::fans`]).
+pub fn facets_intersect_beside(f: &Facet, g: &Facet, star: impl Fn(u32) -> bool) -> bool {
     let mut shared = 0;
     let (mut fi, mut gj) = ([0usize; 3], [0usize; 3]);
     for i in 0..3 {
@@ -429,6 +435,7 @@ pub fn facets_intersect(f: &Facet, g: &Facet) -> bool {
     }
     match shared {
         0 => facets_meet(f, g),
+        1 if star(f.v[fi[0]]) => false,
         1 => {
             // The edges opposite the shared vertex, each against the other triangle.
             let (i, j) = (fi[0], gj[0]);

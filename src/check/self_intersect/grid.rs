@@ -16,7 +16,7 @@
 //! Cells are grouped into bricks of 16³ searched in parallel, each with its own counting sort of
 //! its facets into cells, so the memory beyond the mesh is a few bytes per facet.
 
-use super::exact::{collinear, facets_intersect, Facet, P};
+use super::exact::{collinear, facets_intersect_beside, Facet, P};
 use crate::progress::Progress;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
@@ -198,6 +198,7 @@ pub fn intersecting_pairs(
     // Each brick searched on its own.
     let bricks: Vec<(u64, Bucket)> = bricks.into_iter().collect();
     let counter = progress.counter(bricks.len() as u64, "blocks of facets searched");
+    let star = super::fans::star_vertices(positions, tris);
     let found = Mutex::new(Vec::new());
     bricks.par_iter().for_each(|(key, bucket)| {
         let level = (key >> 60) as u32;
@@ -259,7 +260,7 @@ pub fn intersecting_pairs(
             if u[0].max(v[0]) != cell[0] || u[1].max(v[1]) != cell[1] || u[2].max(v[2]) != cell[2] {
                 return;
             }
-            if facets_intersect(&a.facets[i], &b.facets[j]) {
+            if facets_intersect_beside(&a.facets[i], &b.facets[j], |v| star[v as usize]) {
                 let (f, g) = (a.ids[i], b.ids[j]);
                 local.push((f.min(g), f.max(g)));
             }

@@ -6,6 +6,7 @@
 //! kept as the independent oracle the tests compare it with.
 
 pub mod exact;
+mod fans;
 mod grid;
 
 use crate::error::Result;
