@@ -150,6 +150,9 @@ pub(crate) fn emit_json(
 
 /// The findings of a verification (latvox's or CGAL's), as the summaries print them.
 pub(crate) fn cgal_findings(c: &latvox::check::cgal::Verification) -> String {
+    if c.checked_by == latvox::check::verify::Verify::None.by() {
+        return "not checked (--verify none)".into();
+    }
     format!(
         "closed {}  outward {}  manifold {}  self-intersections {}",
         yes(c.closed),

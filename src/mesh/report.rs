@@ -190,10 +190,10 @@ impl PartReport {
             ));
         }
         if !self.checks.verdict().is_valid_solid() {
-            warnings.push(
-                "CGAL did not find the mesh a valid closed, outward, self-intersection-free solid"
-                    .into(),
-            );
+            warnings.push(format!(
+                "the mesh is not a valid closed, outward, self-intersection-free solid (checked by {})",
+                self.checks.checked_by
+            ));
         }
         let fragments = &self.fragments;
         if fragments.count > 0 {
