@@ -32,8 +32,8 @@ const LEVEL_RATIO: f64 = 4.0;
 /// Level 0's cell is at most this many median facet widths (facets wider go up a level).
 const MEDIAN_RATIO: f64 = 4.0;
 
-/// Intersecting pairs among `tris` (vertex indices into `positions`, xyz triples), as indices
-/// into `tris`, smaller first, sorted; a facet whose corners are collinear is paired with
+/// Intersecting pairs among `tris` (vertex indices into `positions`, xyz triples, finite), as
+/// indices into `tris`, smaller first, sorted; a facet whose corners are collinear is paired with
 /// itself (as CGAL reports a degenerate facet) and takes no other part.
 pub fn intersecting_pairs(
     positions: &[f32],
@@ -102,6 +102,11 @@ pub fn intersecting_pairs(
                 )
             },
         );
+    // Readers refuse non-finite coordinates; a library caller's would make the grid meaningless.
+    assert!(
+        lo.iter().chain(&hi).all(|x| x.is_finite()),
+        "self-intersection search: non-finite vertex coordinates"
+    );
     let step = (tris.len() / 65_536).max(1);
     let mut sample: Vec<f32> = (0..tris.len())
         .step_by(step)
