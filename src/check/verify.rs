@@ -9,6 +9,7 @@ use crate::check::cgal::Verification;
 use crate::error::Result;
 use crate::mesh::topology::UnionFind;
 use crate::mesh::Mesh;
+use crate::mesh::{cross, norm, signed_volume, sub};
 use crate::progress::Progress;
 use rayon::prelude::*;
 
@@ -222,53 +223,41 @@ pub fn topology(mesh: &Mesh) -> Fans {
         ]
     };
     let nc = components as usize;
+    // Per component: volume and bounds; the area.
+    let empty = || {
+        (
+            vec![0.0f64; nc],
+            0.0f64,
+            vec![[f64::INFINITY; 3]; nc],
+            vec![[f64::NEG_INFINITY; 3]; nc],
+        )
+    };
     let (vols, area, lo, hi) = idx
         .par_chunks_exact(3)
-        .fold(
-            || {
-                (
-                    vec![0.0f64; nc],
-                    0.0f64,
-                    vec![[f64::INFINITY; 3]; nc],
-                    vec![[f64::NEG_INFINITY; 3]; nc],
-                )
-            },
-            |(mut vols, mut area, mut lo, mut hi), t| {
-                let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-                let k = comp[root[t[0] as usize] as usize] as usize;
-                let cr = cross(sub(b, a), sub(c, a));
-                vols[k] += dot(a, cross(b, c)) / 6.0;
-                area += 0.5 * dot(cr, cr).sqrt();
-                for q in [a, b, c] {
-                    for i in 0..3 {
-                        lo[k][i] = lo[k][i].min(q[i]);
-                        hi[k][i] = hi[k][i].max(q[i]);
-                    }
+        .fold(empty, |(mut vols, mut area, mut lo, mut hi), t| {
+            let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+            let k = comp[root[t[0] as usize] as usize] as usize;
+            vols[k] += signed_volume(a, b, c);
+            area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
+            for q in [a, b, c] {
+                for i in 0..3 {
+                    lo[k][i] = lo[k][i].min(q[i]);
+                    hi[k][i] = hi[k][i].max(q[i]);
                 }
-                (vols, area, lo, hi)
-            },
-        )
-        .reduce(
-            || {
-                (
-                    vec![0.0f64; nc],
-                    0.0f64,
-                    vec![[f64::INFINITY; 3]; nc],
-                    vec![[f64::NEG_INFINITY; 3]; nc],
-                )
-            },
-            |mut x, y| {
-                for k in 0..nc {
-                    x.0[k] += y.0[k];
-                    for i in 0..3 {
-                        x.2[k][i] = x.2[k][i].min(y.2[k][i]);
-                        x.3[k][i] = x.3[k][i].max(y.3[k][i]);
-                    }
+            }
+            (vols, area, lo, hi)
+        })
+        .reduce(empty, |mut x, y| {
+            for k in 0..nc {
+                x.0[k] += y.0[k];
+                for i in 0..3 {
+                    x.2[k][i] = x.2[k][i].min(y.2[k][i]);
+                    x.3[k][i] = x.3[k][i].max(y.3[k][i]);
                 }
-                x.1 += y.1;
-                x
-            },
-        );
+            }
+            x.1 += y.1;
+            x
+        });
     let volume: f64 = vols.iter().sum();
     let inside = |k: usize, j: usize| (0..3).all(|i| lo[j][i] <= lo[k][i] && hi[k][i] <= hi[j][i]);
     let cavities_enclosed = (0..nc)
@@ -323,22 +312,6 @@ fn fan(link: &[(u32, u32)]) -> (bool, u64) {
         }
     }
     (steps != n, border)
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 #[cfg(test)]
