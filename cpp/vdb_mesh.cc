@@ -71,22 +71,29 @@ void vdb_extract(const VdbGrid& g, Extraction& out) {
   mesher(*grid);
   const std::size_t np = mesher.pointListSize();
   const auto& pts = mesher.pointList();
-
-  out.voxels.reserve(3 * np);
-  out.groups.reserve(np);
-  out.offsets.reserve(3 * np);
+  const auto& pools = mesher.polygonPoolList();
+  const std::size_t npools = mesher.polygonPoolListSize();
+  std::vector<std::size_t> first_quad(npools + 1, 0);
+  for (std::size_t n = 0; n < npools; ++n) {
+    if (pools[n].numTriangles() != 0)
+      throw std::logic_error("volumeToMesh made triangles at adaptivity 0");
+    first_quad[n + 1] = first_quad[n] + pools[n].numQuads();
+  }
   for (std::size_t i = 0; i < np; ++i) {
     const auto& p = pts[i];
     if (!(std::fabs(p.x()) < 4096.f && std::fabs(p.y()) < 4096.f && std::fabs(p.z()) < 4096.f))
       throw std::range_error("index-space point too far from the grid origin to decode");
-    for (int a = 0; a < 3; ++a) out.voxels.push_back(static_cast<int32_t>(std::floor(p[a])));
-    // Points of one voxel come out consecutively, one per edge group in group order.
-    const bool same = i > 0 && out.voxels[3 * i] == out.voxels[3 * i - 3] &&
-                      out.voxels[3 * i + 1] == out.voxels[3 * i - 2] &&
-                      out.voxels[3 * i + 2] == out.voxels[3 * i - 1];
-    out.groups.push_back(same ? static_cast<uint8_t>(out.groups[i - 1] + 1) : 0);
-    for (int a = 0; a < 3; ++a) out.offsets.push_back(0.0);
   }
+  extraction_resize(out, np, first_quad[npools]);
+  int32_t* voxels = out.voxels.data();
+  uint8_t* groups = out.groups.data();
+  double* offsets = out.offsets.data();
+  uint32_t* quads = out.quads.data();
+  auto voxel_of = [&](std::size_t i) {
+    return openvdb::Coord(static_cast<int32_t>(std::floor(pts[i][0])),
+                          static_cast<int32_t>(std::floor(pts[i][1])),
+                          static_cast<int32_t>(std::floor(pts[i][2])));
+  };
 
   std::atomic<bool> mismatch{false};
   std::mutex msg_mutex;
@@ -96,13 +103,18 @@ void vdb_extract(const VdbGrid& g, Extraction& out) {
     auto acc = grid->getConstAccessor();
     std::array<double, 8> values;
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const openvdb::Coord ijk(out.voxels[3 * i], out.voxels[3 * i + 1], out.voxels[3 * i + 2]);
+      const openvdb::Coord ijk = voxel_of(i);
+      for (int a = 0; a < 3; ++a) voxels[3 * i + a] = ijk[a];
+      // Points of one voxel come out consecutively, one per edge group in group order.
+      unsigned g = 0;
+      while (g < i && voxel_of(i - g - 1) == ijk) ++g;
+      groups[i] = static_cast<uint8_t>(g);
       vi::getCellVertexValues(acc, ijk, values);
       uint8_t signs = vi::computeSignFlags(values, 0.0);
       // As volumeToMesh does: an ambiguous face takes its neighbour's reading.
       if (const uint8_t face = vi::sAmbiguousFace[signs])
         vi::correctCellSigns(signs, face, acc, ijk, 0.0f);
-      const unsigned group = out.groups[i] + 1u;
+      const unsigned group = g + 1u;
       if (group > vi::sEdgeGroupTable[signs][0]) {
         std::lock_guard<std::mutex> lock(msg_mutex);
         if (msg.empty())
@@ -123,24 +135,19 @@ void vdb_extract(const VdbGrid& g, Extraction& out) {
                   std::to_string(pts[i][a]) + " recomputed as " + std::to_string(o[a] + ijk[a]);
           mismatch = true;
         }
-        out.offsets[3 * i + a] = o[a];
+        offsets[3 * i + a] = o[a];
       }
     }
   });
   if (mismatch)
     throw std::logic_error("a volumeToMesh point could not be matched to its voxel: " + msg);
 
-  std::size_t nq = 0;
-  const auto& pools = mesher.polygonPoolList();
-  for (std::size_t n = 0; n < mesher.polygonPoolListSize(); ++n) {
-    if (pools[n].numTriangles() != 0)
-      throw std::logic_error("volumeToMesh made triangles at adaptivity 0");
-    nq += pools[n].numQuads();
-  }
-  out.quads.reserve(4 * nq);
-  for (std::size_t n = 0; n < mesher.polygonPoolListSize(); ++n)
-    for (std::size_t q = 0; q < pools[n].numQuads(); ++q)
-      for (int k = 0; k < 4; ++k) out.quads.push_back(pools[n].quad(q)[k]);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, npools),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t n = r.begin(); n != r.end(); ++n)
+      for (std::size_t q = 0; q < pools[n].numQuads(); ++q)
+        for (int k = 0; k < 4; ++k) quads[4 * (first_quad[n] + q) + k] = pools[n].quad(q)[k];
+  });
 }
 
 }  // namespace latvox

@@ -6,6 +6,8 @@
 //! compare these checks with.
 
 use crate::check::cgal::Verification;
+use crate::check::self_intersect::fans::Links;
+use crate::check::self_intersect::{soup_self_intersections_shown, Stars};
 use crate::error::Result;
 use crate::mesh::topology::UnionFind;
 use crate::mesh::Mesh;
@@ -62,36 +64,50 @@ pub fn verify(mesh: &Mesh, how: Verify, progress: &Progress) -> Result<Verificat
     match how {
         Verify::Cgal => crate::check::cgal::verify(mesh, true),
         Verify::None => Ok(unchecked(mesh)),
-        Verify::Full | Verify::Fast => {
-            let (topo, si) = rayon::join(
-                || topology(mesh),
+        Verify::Full => {
+            // The fans are checked beside the search's bucketing (it needs their star vertices
+            // only to search), the components measured beside the whole search.
+            let fans = std::sync::OnceLock::new();
+            let stars = Stars::Beside(Box::new(|| {
+                let mut f = vertex_fans(mesh, true);
+                let star = std::mem::take(&mut f.star);
+                let _ = fans.set(f);
+                star
+            }));
+            let (m, pairs) = rayon::join(
+                || measures(mesh),
                 || {
-                    (how == Verify::Full).then(|| {
-                        let all: Vec<u32> = (0..mesh.triangle_count() as u32)
-                            .filter(|&f| !crate::mesh::topology::repeats_vertex(mesh, f as usize))
-                            .collect();
-                        crate::check::self_intersect::soup_self_intersections_shown(
-                            mesh, &all, 0, progress,
-                        )
-                        .0
-                    })
+                    let all: Vec<u32> = (0..mesh.triangle_count() as u32)
+                        .into_par_iter()
+                        .filter(|&f| !crate::mesh::topology::repeats_vertex(mesh, f as usize))
+                        .collect();
+                    soup_self_intersections_shown(mesh, &all, 0, stars, progress).0
                 },
             );
-            Ok(Verification {
-                checked_by: how.by(),
-                manifold: topo.manifold,
-                closed: topo.border_edges == 0 && topo.manifold,
-                outward: topo.outward,
-                self_intersection_checked: si.is_some(),
-                self_intersecting: si.is_some_and(|n| n > 0),
-                volume: (topo.border_edges == 0 && topo.manifold).then_some(topo.volume),
-                area: topo.area,
-                faces: mesh.triangle_count() as u64,
-                vertices: topo.vertices,
-                border_edges: topo.border_edges,
-                components: topo.components,
-            })
+            let fans = fans
+                .into_inner()
+                .expect("the search asks for the star vertices");
+            Ok(verification(mesh, how, assemble(&fans, &m), Some(pairs)))
         }
+        Verify::Fast => Ok(verification(mesh, how, topology(mesh), None)),
+    }
+}
+
+/// The verification `how` gave: the fans' verdict, and with `pairs`, the intersecting pairs'.
+fn verification(mesh: &Mesh, how: Verify, topo: Fans, pairs: Option<u64>) -> Verification {
+    Verification {
+        checked_by: how.by(),
+        manifold: topo.manifold,
+        closed: topo.border_edges == 0 && topo.manifold,
+        outward: topo.outward,
+        self_intersection_checked: pairs.is_some(),
+        self_intersecting: pairs.is_some_and(|n| n > 0),
+        volume: (topo.border_edges == 0 && topo.manifold).then_some(topo.volume),
+        area: topo.area,
+        faces: mesh.triangle_count() as u64,
+        vertices: topo.vertices,
+        border_edges: topo.border_edges,
+        components: topo.components,
     }
 }
 
@@ -141,66 +157,116 @@ pub struct Fans {
 /// must chain into one cycle (or one path at a border), each edge from it met once in each
 /// direction.
 pub fn topology(mesh: &Mesh) -> Fans {
+    let (fans, m) = rayon::join(|| vertex_fans(mesh, false), || measures(mesh));
+    assemble(&fans, &m)
+}
+
+/// What the vertices' fans say.
+struct VertexFans {
+    /// Some facet repeats a vertex, or some vertex's fan is unsound.
+    bad: bool,
+    /// Half-edges without a twin.
+    border: u64,
+    /// Vertices used by some facet.
+    used: u64,
+    /// Per vertex, when asked for: its closed fan projects one-to-one onto an axis plane (see
+    /// [`crate::check::self_intersect::fans`]); empty otherwise.
+    star: Vec<bool>,
+}
+
+/// Each vertex's link edges b → c (facet v, b, c in winding order) checked as one fan, and
+/// with `stars`, whether that fan projects one-to-one.
+fn vertex_fans(mesh: &Mesh, stars: bool) -> VertexFans {
     let nv = mesh.vertex_count();
-    let nf = mesh.triangle_count();
-    let idx = &mesh.indices;
-    let repeated = (0..nf)
+    let repeated = (0..mesh.triangle_count())
         .into_par_iter()
         .any(|f| crate::mesh::topology::repeats_vertex(mesh, f));
-    // Corners (3f + k) by vertex.
-    let mut start = vec![0u32; nv + 1];
-    for &v in idx.iter() {
-        start[v as usize + 1] += 1;
-    }
-    for v in 0..nv {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut corners = vec![0u32; idx.len()];
-    for (c, &v) in idx.iter().enumerate() {
-        let s = &mut fill[v as usize];
-        corners[*s as usize] = c as u32;
-        *s += 1;
-    }
-    drop(fill);
-    // Each vertex: its link edges b → c (facet v, b, c in winding order).
+    let links = Links::new(nv, &mesh.indices, stars.then_some(&mesh.positions[..]));
     const CHUNK: usize = 4096;
-    let (bad, border, used) = (0..nv.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|chunk| {
-            let mut link: Vec<(u32, u32)> = Vec::new();
-            let (mut bad, mut border, mut used) = (false, 0u64, 0u64);
-            for v in chunk * CHUNK..((chunk + 1) * CHUNK).min(nv) {
-                let cs = &corners[start[v] as usize..start[v + 1] as usize];
-                if cs.is_empty() {
-                    continue;
-                }
-                used += 1;
-                link.clear();
-                link.extend(cs.iter().map(|&c| {
-                    let (f, k) = (c as usize / 3, c as usize % 3);
-                    (idx[3 * f + (k + 1) % 3], idx[3 * f + (k + 2) % 3])
-                }));
-                let (b_fan, b_border) = fan(&link);
-                bad |= b_fan;
-                border += b_border;
+    let mut star = vec![false; if stars { nv } else { 0 }];
+    let check = |chunk: usize, out: &mut [bool]| {
+        let (mut bad, mut border, mut used) = (false, 0u64, 0u64);
+        for v in chunk * CHUNK..((chunk + 1) * CHUNK).min(nv) {
+            let link = links.of(v);
+            if link.is_empty() {
+                continue;
             }
-            (bad, border, used)
-        })
-        .reduce(|| (false, 0, 0), |x, y| (x.0 || y.0, x.1 + y.1, x.2 + y.2));
-    let manifold = !repeated && !bad;
+            used += 1;
+            let (b_fan, b_border) = fan(link);
+            bad |= b_fan;
+            border += b_border;
+            if !out.is_empty() && !b_fan && b_border == 0 {
+                out[v - chunk * CHUNK] = links.projects_one_to_one(v);
+            }
+        }
+        (bad, border, used)
+    };
+    let sum = |x: (bool, u64, u64), y: (bool, u64, u64)| (x.0 || y.0, x.1 + y.1, x.2 + y.2);
+    let (bad, border, used) = if stars {
+        star.par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(chunk, out)| check(chunk, out))
+            .reduce(|| (false, 0, 0), sum)
+    } else {
+        (0..nv.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|chunk| check(chunk, &mut []))
+            .reduce(|| (false, 0, 0), sum)
+    };
+    VertexFans {
+        bad: bad || repeated,
+        border,
+        used,
+        star,
+    }
+}
 
+/// The components of a mesh, its volume and area.
+struct Measures {
+    /// Connected components (facets joined through shared vertices).
+    components: u64,
+    /// Signed volume enclosed, mm³.
+    volume: f64,
+    /// Surface area, mm².
+    area: f64,
+    /// Every component enclosing negative volume lies within the bounds of a larger positive
+    /// one.
+    cavities_enclosed: bool,
+}
+
+/// The fans' verdict with the measures.
+fn assemble(fans: &VertexFans, m: &Measures) -> Fans {
+    let manifold = !fans.bad;
+    Fans {
+        manifold,
+        border_edges: fans.border,
+        outward: manifold && fans.border == 0 && m.volume > 0.0 && m.cavities_enclosed,
+        volume: m.volume,
+        area: m.area,
+        components: m.components,
+        vertices: fans.used,
+    }
+}
+
+/// The components, volume and area of `mesh`.
+fn measures(mesh: &Mesh) -> Measures {
+    let nv = mesh.vertex_count();
+    let idx = &mesh.indices;
     // Components through shared vertices; volume and area per component.
     let mut uf = UnionFind::new(nv);
     for t in idx.chunks_exact(3) {
         uf.union(t[0], t[1]);
         uf.union(t[0], t[2]);
     }
+    let mut used = vec![false; nv];
+    for &v in idx.iter() {
+        used[v as usize] = true;
+    }
     let root: Vec<u32> = (0..nv as u32).map(|v| uf.find(v)).collect();
     let mut comp = vec![u32::MAX; nv];
     let mut components = 0u32;
     for v in 0..nv {
-        if start[v + 1] > start[v] {
+        if used[v] {
             let r = root[v] as usize;
             if comp[r] == u32::MAX {
                 comp[r] = components;
@@ -263,14 +329,11 @@ pub fn topology(mesh: &Mesh) -> Fans {
     let cavities_enclosed = (0..nc)
         .filter(|&k| vols[k] < 0.0)
         .all(|k| (0..nc).any(|j| vols[j] > 0.0 && vols[j] > -vols[k] && inside(k, j)));
-    Fans {
-        manifold,
-        border_edges: border,
-        outward: manifold && border == 0 && volume > 0.0 && cavities_enclosed,
+    Measures {
+        components: components as u64,
         volume,
         area,
-        components: components as u64,
-        vertices: used,
+        cavities_enclosed,
     }
 }
 
@@ -279,14 +342,14 @@ pub fn topology(mesh: &Mesh) -> Fans {
 /// once each way), and the link edges chain into one cycle, or one path where the fan meets a
 /// border. A half-edge v → b without its twin b → v is a border half-edge (the link edge that
 /// starts at b has no link edge ending at b).
-fn fan(link: &[(u32, u32)]) -> (bool, u64) {
+fn fan(link: &[[u32; 2]]) -> (bool, u64) {
     let n = link.len();
-    let starts_at = |x: u32| link.iter().filter(|e| e.0 == x).count();
-    let ends_at = |x: u32| link.iter().filter(|e| e.1 == x).count();
+    let starts_at = |x: u32| link.iter().filter(|e| e[0] == x).count();
+    let ends_at = |x: u32| link.iter().filter(|e| e[1] == x).count();
     let mut border = 0u64;
     let mut bad = false;
     let mut path_start = None;
-    for &(b, c) in link {
+    for &[b, c] in link {
         if starts_at(b) != 1 || ends_at(c) != 1 {
             bad = true;
         }
@@ -301,10 +364,10 @@ fn fan(link: &[(u32, u32)]) -> (bool, u64) {
         return (true, border);
     }
     // Walk the chain from the path's start (or anywhere on a cycle); it must cover every facet.
-    let first = path_start.unwrap_or(link[0].0);
+    let first = path_start.unwrap_or(link[0][0]);
     let mut at = first;
     let mut steps = 0;
-    while let Some(&(_, c)) = link.iter().find(|e| e.0 == at) {
+    while let Some(&[_, c]) = link.iter().find(|e| e[0] == at) {
         steps += 1;
         at = c;
         if at == first || steps > n {

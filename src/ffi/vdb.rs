@@ -26,6 +26,12 @@ pub(crate) mod ffi {
         Mean,
     }
 
+    extern "Rust" {
+        /// Sizes `out` for `points` points and `quads` quads (zero-filled), so that the C++ side
+        /// fills it in parallel.
+        fn extraction_resize(out: &mut Extraction, points: usize, quads: usize);
+    }
+
     unsafe extern "C++" {
         include!("latvox/cpp/vdb.h");
 
@@ -65,6 +71,13 @@ pub(crate) mod ffi {
         fn vdb_memory_bytes(grid: &VdbGrid) -> u64;
         fn vdb_write(grid: &VdbGrid, path: &str) -> Result<()>;
     }
+}
+
+fn extraction_resize(out: &mut ffi::Extraction, points: usize, quads: usize) {
+    out.voxels.resize(3 * points, 0);
+    out.groups.resize(points, 0);
+    out.offsets.resize(3 * points, 0.0);
+    out.quads.resize(4 * quads, 0);
 }
 
 // SAFETY: an OpenVDB grid is immutable once built here; const methods are thread-safe.

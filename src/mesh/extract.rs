@@ -53,6 +53,7 @@ impl KeyedMesh {
         let spec = grid.spec;
         let np = ex.groups.len();
         let keys: Vec<VertexKey> = (0..np)
+            .into_par_iter()
             .map(|i| VertexKey {
                 voxel: [ex.voxels[3 * i], ex.voxels[3 * i + 1], ex.voxels[3 * i + 2]],
                 group: ex.groups[i],
@@ -60,7 +61,7 @@ impl KeyedMesh {
             .collect();
         let offsets: Vec<[f64; 3]> = ex
             .offsets
-            .chunks_exact(3)
+            .par_chunks_exact(3)
             .map(|o| [o[0], o[1], o[2]])
             .collect();
         let positions: Vec<[f64; 3]> = keys
@@ -71,11 +72,11 @@ impl KeyedMesh {
         // OpenVDB winds quads inward: reverse them.
         let quads: Vec<[u32; 4]> = ex
             .quads
-            .chunks_exact(4)
+            .par_chunks_exact(4)
             .map(|q| [q[3], q[2], q[1], q[0]])
             .collect();
         let edges = quads
-            .iter()
+            .par_iter()
             .map(|q| quad_edge(q.map(|v| keys[v as usize].voxel)))
             .collect();
         let mut m = KeyedMesh {

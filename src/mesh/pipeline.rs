@@ -737,12 +737,19 @@ fn write_whole(
     progress: &Progress,
     sink: &mut dyn MeshSink,
 ) -> Result<Written> {
-    // The part is verified while it is written: the search is on the cores, the writing mostly
-    // on the disk.
+    // The part is verified while it is written. The search runs on threads of its own, as many
+    // as rayon's: in the shared pool the writer's short batches would queue behind its long
+    // tasks (writing took longer than verifying); beside it, the system shares the cores.
     let (checks, verify_seconds, measures, write_seconds) = std::thread::scope(|scope| {
         let checker = scope.spawn(|| {
             let t = Instant::now();
-            let r = verify(&mesh, o.verify, progress);
+            let r = match rayon::ThreadPoolBuilder::new()
+                .num_threads(rayon::current_num_threads())
+                .build()
+            {
+                Ok(pool) => pool.install(|| verify(&mesh, o.verify, progress)),
+                Err(_) => verify(&mesh, o.verify, progress),
+            };
             (r, t.elapsed().as_secs_f64())
         });
         let t = Instant::now();

@@ -170,6 +170,9 @@ pub struct Facet {
     pub p: [P; 3],
     /// The plane through the corners, oriented by them.
     pub plane: Plane,
+    /// Bit `k` set when corner `k`'s vertex is known to hold no intersecting pair among the
+    /// facets around it that share it (see [`super::fans`]).
+    pub star: u8,
 }
 
 impl Facet {
@@ -180,7 +183,15 @@ impl Facet {
             v,
             p,
             plane: Plane::new(&p[0], &p[1], &p[2]),
+            star: 0,
         }
+    }
+
+    /// The facet with its corners' [`Facet::star`] bits read from `star` (per vertex).
+    #[inline]
+    pub fn with_star(mut self, star: &[bool]) -> Facet {
+        self.star = (0..3).fold(0, |m, k| m | (star[self.v[k] as usize] as u8) << k);
+        self
     }
 
     /// The sign of `orientation(p0, p1, p2, s)`.
@@ -414,14 +425,9 @@ fn coplanar_segment_meets_triangle(aa: &P, bb: &P, cc: &P, p: &P, q: &P) -> bool
 /// Whether facets `f` and `g` (neither degenerate) intersect in more than the vertices and edge
 /// they share — CGAL's `do_faces_intersect`, with sharing read off the vertex indices. Facets
 /// sharing all three vertices (duplicates) are not counted here: `check` reports them as
-/// duplicate facets.
+/// duplicate facets. Pairs sharing a vertex that `f`'s [`Facet::star`] bits mark are answered
+/// without a test.
 pub fn facets_intersect(f: &Facet, g: &Facet) -> bool {
-    facets_intersect_beside(f, g, |_| false)
-}
-
-/// [`facets_intersect`], told which vertices are known to hold no intersecting pair of facets
-/// sharing only them (see [`super::fans`]).
-pub fn facets_intersect_beside(f: &Facet, g: &Facet, star: impl Fn(u32) -> bool) -> bool {
     let mut shared = 0;
     let (mut fi, mut gj) = ([0usize; 3], [0usize; 3]);
     for i in 0..3 {
@@ -433,15 +439,19 @@ pub fn facets_intersect_beside(f: &Facet, g: &Facet, star: impl Fn(u32) -> bool)
             }
         }
     }
+    // A shared vertex of `f` whose star bit is set: both facets lie in its fan, which projects
+    // one-to-one, so they meet only in what they share (the vertex, or an edge from it).
+    let starred = |k: usize| f.star & (1 << fi[k]) != 0;
     match shared {
         0 => facets_meet(f, g),
-        1 if star(f.v[fi[0]]) => false,
+        1 if starred(0) => false,
         1 => {
             // The edges opposite the shared vertex, each against the other triangle.
             let (i, j) = (fi[0], gj[0]);
             segment_meets_facet(f, &g.p[(j + 1) % 3], &g.p[(j + 2) % 3])
                 || segment_meets_facet(g, &f.p[(i + 1) % 3], &f.p[(i + 2) % 3])
         }
+        2 if starred(0) || starred(1) => false,
         2 => {
             // A shared edge u–v: a fold when the third vertices are coplanar with it and on one
             // side of it.

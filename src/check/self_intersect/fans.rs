@@ -1,62 +1,176 @@
-//! Vertices whose facets provably hold no intersecting pair among those sharing only that vertex
-//! — most vertices of a smooth mesh — so the exact tests skip those pairs (on a mesh latvox
-//! makes, three quarters of the pairs whose boxes overlap).
+//! Vertices whose facets provably hold no intersecting pair among those sharing that vertex —
+//! most vertices of a smooth mesh — so the exact tests skip those pairs (on a mesh latvox makes,
+//! nearly all the pairs whose boxes overlap).
 //!
 //! A vertex v qualifies when its facets (v, b, c) close into one fan that an axis projection
-//! maps one-to-one: every facet keeps a strictly positive orientation in the projection (exact,
+//! maps one-to-one: every facet has the same strict orientation in the projection (exact,
 //! Shewchuk's `orient2d` on the f32 coordinates), each neighbour b starts exactly one link edge
-//! b → c and ends exactly one, and the link edges wind once around v. The winding number is the
-//! count of link edges b → c with `b.y ≤ v.y < c.y` in the projection: each facet spans a sector
-//! of less than half a turn, and such a sector holds the direction +x (half-open) exactly when
-//! its first edge is in the closed lower half-plane and its second in the open upper one —
-//! comparisons of coordinates only. Winding once, the sectors tile the plane around v without
-//! overlap, so two facets that share no edge meet in the projection only at v, and in space only
-//! at v: CGAL's test for a pair sharing one vertex (does either opposite edge meet the other
-//! facet?) answers no for every such pair.
+//! b → c and ends exactly one, and the link edges wind once around v. With the projection's axes
+//! ordered to make the orientations positive, the winding number is the count of link edges
+//! b → c with `b.y ≤ v.y < c.y`: each facet spans a sector of less than half a turn, and such a
+//! sector holds the direction +x (half-open) exactly when its first edge is in the closed lower
+//! half-plane and its second in the open upper one — comparisons of coordinates only. Winding
+//! once, the sectors tile the plane around v without overlap, so two facets that share no edge
+//! meet in the projection only at v, and in space only at v: CGAL's test for a pair sharing one
+//! vertex (does either opposite edge meet the other facet?) answers no for every such pair. Two
+//! facets sharing an edge v–w lie on either side of it in the projection, so they meet only
+//! along it: no fold. Any axis on which the facets agree will do; each is tried.
+//!
+//! All of it is read off bits computed once per facet, in facet order (no vertex's neighbours
+//! fetched from memory): the sign of a projected triangle's orientation is the same from each of
+//! its corners, and the `b.y ≤ v.y < c.y` tests are per corner, for each of the three axes `y`.
 
 use rayon::prelude::*;
 use robust::{orient2d, Coord};
 
+/// Facet bits: `1 << (2a)` when the facet's projection along axis `a` is positive, `1 << (2a+1)`
+/// when negative.
+const SIGNS: u16 = 0x3f;
+/// Corner bits (beside [`SIGNS`]): `1 << (6 + y)` when `b.y ≤ v.y < c.y` for the corner at v of
+/// the facet (v, b, c).
+const WINDING: u32 = 6;
+
+/// The link edges of every vertex: for each corner of a facet (v, b, c) in winding order, the
+/// edge b → c filed under v (a counting sort by vertex), and when asked for, the corner's bits
+/// for the projection test.
+pub struct Links {
+    start: Vec<u32>,
+    link: Vec<[u32; 2]>,
+    bits: Vec<u16>,
+}
+
+impl Links {
+    /// The links of `nv` vertices among the facets `indices` (vertex index triples, flat); with
+    /// `positions`, the bits of the projection test too.
+    pub fn new(nv: usize, indices: &[u32], positions: Option<&[f32]>) -> Links {
+        let facet_bits: Vec<u16> = match positions {
+            Some(p) => indices.par_chunks_exact(3).map(|t| bits(p, t)).collect(),
+            None => Vec::new(),
+        };
+        let mut start = vec![0u32; nv + 1];
+        for &v in indices {
+            start[v as usize + 1] += 1;
+        }
+        for v in 0..nv {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut link = vec![[0u32; 2]; indices.len()];
+        let mut corner_bits = vec![
+            0u16;
+            if positions.is_some() {
+                indices.len()
+            } else {
+                0
+            }
+        ];
+        for (f, t) in indices.chunks_exact(3).enumerate() {
+            for k in 0..3 {
+                let s = &mut fill[t[k] as usize];
+                link[*s as usize] = [t[(k + 1) % 3], t[(k + 2) % 3]];
+                if let Some(&b) = facet_bits.get(f) {
+                    let w = (b >> (WINDING + 3 * k as u32)) & 7;
+                    corner_bits[*s as usize] = (b & SIGNS) | (w << WINDING);
+                }
+                *s += 1;
+            }
+        }
+        Links {
+            start,
+            link,
+            bits: corner_bits,
+        }
+    }
+
+    /// Vertices.
+    pub fn len(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    /// Whether there are no vertices.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The link edges of `v`.
+    #[inline]
+    pub fn of(&self, v: usize) -> &[[u32; 2]] {
+        &self.link[self.start[v] as usize..self.start[v + 1] as usize]
+    }
+
+    /// Whether the facets of `v` — each neighbour starting one link edge and ending one, as a
+    /// closed fan has — project one-to-one onto an axis plane around `v` (see the module's
+    /// text); false when the links were built without positions.
+    pub fn projects_one_to_one(&self, v: usize) -> bool {
+        let bits = &self
+            .bits
+            .get(self.start[v] as usize..self.start[v + 1] as usize);
+        let Some(bits) = bits.filter(|b| b.len() >= 3) else {
+            return false;
+        };
+        let agree = bits.iter().fold(SIGNS, |m, b| m & b);
+        (0..3).any(|a| {
+            // Positive along a: (x, y) = (a+1, a+2); negative: swapped, to make it positive.
+            [(2 * a, (a + 2) % 3), (2 * a + 1, (a + 1) % 3)]
+                .into_iter()
+                .any(|(sign, y)| {
+                    agree & (1 << sign) != 0
+                        && bits
+                            .iter()
+                            .filter(|&&b| b & (1 << (WINDING as usize + y)) != 0)
+                            .count()
+                            == 1
+                })
+        })
+    }
+}
+
+/// The bits of the facet `t` (see [`SIGNS`] and [`WINDING`]; corner `k`'s winding bits at
+/// `6 + 3k`).
+fn bits(positions: &[f32], t: &[u32]) -> u16 {
+    let p = [t[0], t[1], t[2]].map(|i| {
+        let k = 3 * i as usize;
+        [positions[k], positions[k + 1], positions[k + 2]]
+    });
+    let mut out = 0u16;
+    for a in 0..3 {
+        let (x, y) = ((a + 1) % 3, (a + 2) % 3);
+        let c2 = |q: &[f32; 3]| Coord {
+            x: q[x] as f64,
+            y: q[y] as f64,
+        };
+        let o = orient2d(c2(&p[0]), c2(&p[1]), c2(&p[2]));
+        if o > 0.0 {
+            out |= 1 << (2 * a);
+        } else if o < 0.0 {
+            out |= 1 << (2 * a + 1);
+        }
+    }
+    for k in 0..3 {
+        let (v, b, c) = (&p[k], &p[(k + 1) % 3], &p[(k + 2) % 3]);
+        for y in 0..3 {
+            if b[y] <= v[y] && v[y] < c[y] {
+                out |= 1 << (WINDING as usize + 3 * k + y);
+            }
+        }
+    }
+    out
+}
+
 /// Per vertex of `positions`, whether it qualifies (see the module's text) among the facets
 /// `tris`.
 pub fn star_vertices(positions: &[f32], tris: &[[u32; 3]]) -> Vec<bool> {
-    let nv = positions.len() / 3;
-    let mut start = vec![0u32; nv + 1];
-    for t in tris {
-        for &v in t {
-            start[v as usize + 1] += 1;
-        }
-    }
-    for v in 0..nv {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut link = vec![[0u32; 2]; start[nv] as usize];
-    for t in tris {
-        for k in 0..3 {
-            let s = &mut fill[t[k] as usize];
-            link[*s as usize] = [t[(k + 1) % 3], t[(k + 2) % 3]];
-            *s += 1;
-        }
-    }
-    drop(fill);
-    (0..nv)
+    let links = Links::new(positions.len() / 3, tris.as_flattened(), Some(positions));
+    (0..links.len())
         .into_par_iter()
         .with_min_len(4096)
-        .map(|v| {
-            star(
-                positions,
-                v as u32,
-                &link[start[v] as usize..start[v + 1] as usize],
-            )
-        })
+        .map(|v| star(&links, v))
         .collect()
 }
 
-fn star(positions: &[f32], v: u32, link: &[[u32; 2]]) -> bool {
-    if link.len() < 3 {
-        return false;
-    }
+/// Whether `v` qualifies (see the module's text).
+fn star(links: &Links, v: usize) -> bool {
+    let link = links.of(v);
     // One link edge starting and one ending at each neighbour.
     for e in link {
         if link.iter().filter(|f| f[0] == e[0]).count() != 1
@@ -65,40 +179,5 @@ fn star(positions: &[f32], v: u32, link: &[[u32; 2]]) -> bool {
             return false;
         }
     }
-    let p = |i: u32| {
-        let k = 3 * i as usize;
-        [positions[k], positions[k + 1], positions[k + 2]]
-    };
-    let o = p(v);
-    // The projection along the axis the fan's normal leans on most (any choice is sound; this
-    // one makes the orientations positive on smooth fans), oriented to make them positive.
-    let mut n = [0.0f64; 3];
-    for e in link {
-        let (b, c) = (p(e[0]), p(e[1]));
-        let u = [0, 1, 2].map(|i| b[i] as f64 - o[i] as f64);
-        let w = [0, 1, 2].map(|i| c[i] as f64 - o[i] as f64);
-        n[0] += u[1] * w[2] - u[2] * w[1];
-        n[1] += u[2] * w[0] - u[0] * w[2];
-        n[2] += u[0] * w[1] - u[1] * w[0];
-    }
-    let a = (0..3)
-        .max_by(|&i, &j| n[i].abs().total_cmp(&n[j].abs()))
-        .unwrap_or(2);
-    let (mut x, mut y) = ((a + 1) % 3, (a + 2) % 3);
-    if n[a] < 0.0 {
-        std::mem::swap(&mut x, &mut y);
-    }
-    let c2 = |q: [f32; 3]| Coord {
-        x: q[x] as f64,
-        y: q[y] as f64,
-    };
-    let mut winding = 0;
-    for e in link {
-        let (b, c) = (p(e[0]), p(e[1]));
-        if orient2d(c2(o), c2(b), c2(c)) <= 0.0 {
-            return false;
-        }
-        winding += (b[y] <= o[y] && o[y] < c[y]) as u32;
-    }
-    winding == 1
+    links.projects_one_to_one(v)
 }

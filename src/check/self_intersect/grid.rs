@@ -16,7 +16,7 @@
 //! Cells are grouped into bricks of 16³ searched in parallel, each with its own counting sort of
 //! its facets into cells, so the memory beyond the mesh is a few bytes per facet.
 
-use super::exact::{collinear, facets_intersect_beside, Facet, P};
+use super::exact::{collinear, facets_intersect, Facet, P};
 use crate::progress::Progress;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
@@ -34,10 +34,12 @@ const MEDIAN_RATIO: f64 = 4.0;
 
 /// Intersecting pairs among `tris` (vertex indices into `positions`, xyz triples, finite), as
 /// indices into `tris`, smaller first, sorted; a facet whose corners are collinear is paired with
-/// itself (as CGAL reports a degenerate facet) and takes no other part.
+/// itself (as CGAL reports a degenerate facet) and takes no other part. The star vertices (see
+/// [`super::fans`]) come from `stars`, computed while the facets are bucketed.
 pub fn intersecting_pairs(
     positions: &[f32],
     tris: &[[u32; 3]],
+    stars: Stars<'_>,
     progress: &Progress,
 ) -> Vec<(u32, u32)> {
     let point = |v: u32| -> P {
@@ -153,57 +155,61 @@ pub fn intersecting_pairs(
         ((c[0] as u64) << (2 * AXIS_BITS)) | ((c[1] as u64) << AXIS_BITS) | c[2] as u64
     };
 
-    // Facets into the bricks of their level (natives). Degenerate facets are bucketed too, and
-    // found where their boxes are (in parallel); they take part in no pair.
-    let level_of_facet = |i: usize| level_of(width(&bbox(&tris[i])));
-    let mut bricks: HashMap<u64, Bucket> = HashMap::new();
-    let natives = bucket(tris.len(), |i, push| {
-        let b = bbox(&tris[i]);
-        let l = level_of(width(&b));
-        for_each_brick(cells(&b, l), |k| push(brick_key(l, k), i as u32));
-    });
-    let top = natives.keys().map(|k| (k >> 60) as u32).max().unwrap_or(0);
-    for (k, v) in natives {
-        bricks.entry(k).or_default().natives = v;
-    }
-    // Facets of finer levels as queries on each coarser level that has facets.
-    for coarse in 1..=top {
-        let on_level: Vec<usize> = (0..tris.len())
-            .into_par_iter()
-            .filter(|&i| level_of_facet(i) == coarse)
-            .collect();
-        let occupied: HashSet<u64> = on_level
-            .iter()
-            .flat_map(|&i| {
-                let mut keys = Vec::with_capacity(8);
-                for_each_cell(cells(&bbox(&tris[i]), coarse), |x| keys.push(cell_key(x)));
-                keys
-            })
-            .collect();
-        if occupied.is_empty() {
-            continue;
-        }
-        let queries = bucket(tris.len(), |i, push| {
+    // Facets into the bricks of their level (natives), and as queries into coarser levels'
+    // bricks, while the star vertices are found. Degenerate facets are bucketed too, and found
+    // where their boxes are (in parallel); they take part in no pair.
+    let bucketing = || {
+        let level_of_facet = |i: usize| level_of(width(&bbox(&tris[i])));
+        let mut bricks: HashMap<u64, Bucket> = HashMap::new();
+        let natives = bucket(tris.len(), |i, push| {
             let b = bbox(&tris[i]);
-            if level_of(width(&b)) >= coarse {
-                return;
-            }
-            let c = cells(&b, coarse);
-            let mut hit = false;
-            for_each_cell(c, |x| hit |= occupied.contains(&cell_key(x)));
-            if hit {
-                for_each_brick(c, |k| push(brick_key(coarse, k), i as u32));
-            }
+            let l = level_of(width(&b));
+            for_each_brick(cells(&b, l), |k| push(brick_key(l, k), i as u32));
         });
-        for (k, v) in queries {
-            bricks.entry(k).or_default().queries = v;
+        let top = natives.keys().map(|k| (k >> 60) as u32).max().unwrap_or(0);
+        for (k, v) in natives {
+            bricks.entry(k).or_default().natives = v;
         }
-    }
+        // Facets of finer levels as queries on each coarser level that has facets.
+        for coarse in 1..=top {
+            let on_level: Vec<usize> = (0..tris.len())
+                .into_par_iter()
+                .filter(|&i| level_of_facet(i) == coarse)
+                .collect();
+            let occupied: HashSet<u64> = on_level
+                .iter()
+                .flat_map(|&i| {
+                    let mut keys = Vec::with_capacity(8);
+                    for_each_cell(cells(&bbox(&tris[i]), coarse), |x| keys.push(cell_key(x)));
+                    keys
+                })
+                .collect();
+            if occupied.is_empty() {
+                continue;
+            }
+            let queries = bucket(tris.len(), |i, push| {
+                let b = bbox(&tris[i]);
+                if level_of(width(&b)) >= coarse {
+                    return;
+                }
+                let c = cells(&b, coarse);
+                let mut hit = false;
+                for_each_cell(c, |x| hit |= occupied.contains(&cell_key(x)));
+                if hit {
+                    for_each_brick(c, |k| push(brick_key(coarse, k), i as u32));
+                }
+            });
+            for (k, v) in queries {
+                bricks.entry(k).or_default().queries = v;
+            }
+        }
+        bricks.into_iter().collect::<Vec<(u64, Bucket)>>()
+    };
+    let (bricks, star) = rayon::join(bucketing, || stars.get(positions, tris));
+    let star = &star[..];
 
     // Each brick searched on its own.
-    let bricks: Vec<(u64, Bucket)> = bricks.into_iter().collect();
     let counter = progress.counter(bricks.len() as u64, "blocks of facets searched");
-    let star = super::fans::star_vertices(positions, tris);
     let found = Mutex::new(Vec::new());
     bricks.par_iter().for_each(|(key, bucket)| {
         let level = (key >> 60) as u32;
@@ -236,7 +242,7 @@ pub fn intersecting_pairs(
                 }
                 continue;
             }
-            natives.push(id, Facet::new(t, p), b, c);
+            natives.push(id, Facet::new(t, p).with_star(star), b, c);
         }
         let mut queries = Members::default();
         for &id in &bucket.queries {
@@ -244,7 +250,7 @@ pub fn intersecting_pairs(
             let p = t.map(point);
             if !collinear(&p[0], &p[1], &p[2]) {
                 let b = bbox(&t);
-                queries.push(id, Facet::new(t, p), b, cells(&b, level));
+                queries.push(id, Facet::new(t, p).with_star(star), b, cells(&b, level));
             }
         }
         let nat_cells = sort_into_cells(&natives.cells, base);
@@ -265,7 +271,7 @@ pub fn intersecting_pairs(
             if u[0].max(v[0]) != cell[0] || u[1].max(v[1]) != cell[1] || u[2].max(v[2]) != cell[2] {
                 return;
             }
-            if facets_intersect_beside(&a.facets[i], &b.facets[j], |v| star[v as usize]) {
+            if facets_intersect(&a.facets[i], &b.facets[j]) {
                 let (f, g) = (a.ids[i], b.ids[j]);
                 local.push((f.min(g), f.max(g)));
             }
@@ -325,6 +331,24 @@ impl Members {
         self.boxes.push(b);
         self.cells.push(c.map(|x| x.map(|v| v as i32)));
         self.facets.push(f);
+    }
+}
+
+/// Where the search gets its star vertices (see [`super::fans`]) from.
+pub enum Stars<'a> {
+    /// Computed from the facets searched.
+    Own,
+    /// The caller's function's, per vertex of the positions (of these facets or of a mesh
+    /// holding them).
+    Beside(Box<dyn FnOnce() -> Vec<bool> + Send + 'a>),
+}
+
+impl Stars<'_> {
+    fn get(self, positions: &[f32], tris: &[[u32; 3]]) -> Vec<bool> {
+        match self {
+            Stars::Own => super::fans::star_vertices(positions, tris),
+            Stars::Beside(f) => f(),
+        }
     }
 }
 

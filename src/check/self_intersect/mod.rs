@@ -6,8 +6,10 @@
 //! kept as the independent oracle the tests compare it with.
 
 pub mod exact;
-mod fans;
+pub mod fans;
 mod grid;
+
+pub use grid::Stars;
 
 use crate::error::Result;
 use crate::ffi::cgal::ffi;
@@ -23,14 +25,16 @@ use rayon::prelude::*;
 /// read off the vertex indices); a facet whose corners are collinear counts once, as a pair with
 /// itself; facets with the same three vertices are duplicates, not intersections.
 pub fn soup_self_intersections(mesh: &Mesh, keep: &[u32], limit: usize) -> (u64, Vec<(u32, u32)>) {
-    soup_self_intersections_shown(mesh, keep, limit, &Progress::hidden())
+    soup_self_intersections_shown(mesh, keep, limit, Stars::Own, &Progress::hidden())
 }
 
-/// [`soup_self_intersections`] with a bar counting the blocks of the grid searched.
+/// [`soup_self_intersections`] with a bar counting the blocks of the grid searched, and the star
+/// vertices from `stars`.
 pub fn soup_self_intersections_shown(
     mesh: &Mesh,
     keep: &[u32],
     limit: usize,
+    stars: Stars<'_>,
     progress: &Progress,
 ) -> (u64, Vec<(u32, u32)>) {
     let tris: Vec<[u32; 3]> = keep
@@ -40,7 +44,7 @@ pub fn soup_self_intersections_shown(
             [t[0], t[1], t[2]]
         })
         .collect();
-    let pairs = grid::intersecting_pairs(&mesh.positions, &tris, progress);
+    let pairs = grid::intersecting_pairs(&mesh.positions, &tris, stars, progress);
     let total = pairs.len() as u64;
     let pairs = pairs
         .into_iter()
