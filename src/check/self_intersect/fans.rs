@@ -181,3 +181,68 @@ fn star(links: &Links, v: usize) -> bool {
     }
     links.projects_one_to_one(v)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fan of `n` facets around vertex 0 at the origin: link vertex k at angle `turns`·k/n of a
+    /// full turn, radius 1, height `z(k)`; closed (the last facet back to vertex 1) when asked.
+    fn fan(
+        n: usize,
+        turns: f64,
+        z: impl Fn(usize) -> f32,
+        closed: bool,
+    ) -> (Vec<f32>, Vec<[u32; 3]>) {
+        let mut p = vec![0.0f32, 0.0, 0.0];
+        for k in 0..n {
+            let a = std::f64::consts::TAU * turns * k as f64 / n as f64;
+            p.extend([a.cos() as f32, a.sin() as f32, z(k)]);
+        }
+        let facets = if closed { n } else { n - 1 };
+        let tris = (0..facets)
+            .map(|k| [0, 1 + k as u32, 1 + ((k + 1) % n) as u32])
+            .collect();
+        (p, tris)
+    }
+
+    #[test]
+    fn flat_and_saddle_fans_project_one_to_one() {
+        let (p, t) = fan(6, 1.0, |_| 0.0, true);
+        assert!(star_vertices(&p, &t)[0]);
+        // A monkey saddle: up, down, up … still one sheet over the plane.
+        let (p, t) = fan(6, 1.0, |k| if k % 2 == 0 { 0.5 } else { -0.5 }, true);
+        assert!(star_vertices(&p, &t)[0]);
+        // Seen from below (reversed winding): the negative projection, axes swapped.
+        let (p, mut t) = fan(7, 1.0, |k| 0.1 * k as f32, true);
+        t.iter_mut().for_each(|f| f.swap(1, 2));
+        assert!(star_vertices(&p, &t)[0]);
+        // A fan standing on its side projects along another axis.
+        let (p, t) = fan(5, 1.0, |_| 0.0, true);
+        let p: Vec<f32> = p.chunks(3).flat_map(|q| [q[2], q[0], q[1]]).collect();
+        assert!(star_vertices(&p, &t)[0]);
+    }
+
+    #[test]
+    fn folded_open_and_double_fans_do_not() {
+        // Winding twice round (a helicoid): every facet positive, but the projections overlap.
+        let (p, t) = fan(12, 2.0, |k| 0.3 * k as f32, true);
+        assert!(!star_vertices(&p, &t)[0]);
+        // One link vertex pulled across its neighbour: that facet flips.
+        let (mut p, t) = fan(6, 1.0, |_| 0.0, true);
+        p[3 * 2] = 1.2;
+        p[3 * 2 + 1] = -0.3;
+        assert!(!star_vertices(&p, &t)[0]);
+        // An open fan (at a border) proves nothing.
+        let (p, t) = fan(6, 1.0, |_| 0.0, false);
+        assert!(!star_vertices(&p, &t)[0]);
+        // A facet in the fan twice.
+        let (p, mut t) = fan(6, 1.0, |_| 0.0, true);
+        t.push(t[0]);
+        assert!(!star_vertices(&p, &t)[0]);
+        // A degenerate facet (zero area in every projection).
+        let (mut p, t) = fan(6, 1.0, |_| 0.0, true);
+        p[3 * 2..3 * 2 + 3].copy_from_slice(&[0.0, 0.0, 0.0]);
+        assert!(!star_vertices(&p, &t)[0]);
+    }
+}
