@@ -170,9 +170,6 @@ pub struct Facet {
     pub p: [P; 3],
     /// The plane through the corners, oriented by them.
     pub plane: Plane,
-    /// Bit `k` set when corner `k`'s vertex is known to hold no intersecting pair among the
-    /// facets around it that share it (see [`super::fans`]).
-    pub star: u8,
 }
 
 impl Facet {
@@ -183,15 +180,7 @@ impl Facet {
             v,
             p,
             plane: Plane::new(&p[0], &p[1], &p[2]),
-            star: 0,
         }
-    }
-
-    /// The facet with its corners' [`Facet::star`] bits read from `star` (per vertex).
-    #[inline]
-    pub fn with_star(mut self, star: &[bool]) -> Facet {
-        self.star = (0..3).fold(0, |m, k| m | (star[self.v[k] as usize] as u8) << k);
-        self
     }
 
     /// The sign of `orientation(p0, p1, p2, s)`.
@@ -422,36 +411,53 @@ fn coplanar_segment_meets_triangle(aa: &P, bb: &P, cc: &P, p: &P, q: &P) -> bool
     }
 }
 
-/// Whether facets `f` and `g` (neither degenerate) intersect in more than the vertices and edge
-/// they share — CGAL's `do_faces_intersect`, with sharing read off the vertex indices. Facets
-/// sharing all three vertices (duplicates) are not counted here: `check` reports them as
-/// duplicate facets. Pairs sharing a vertex that `f`'s [`Facet::star`] bits mark are answered
-/// without a test.
-pub fn facets_intersect(f: &Facet, g: &Facet) -> bool {
+/// How many vertex indices facets `f` and `g` share, and at which corners of each.
+#[inline]
+pub fn sharing(f: &[u32; 3], g: &[u32; 3]) -> (usize, [usize; 3], [usize; 3]) {
     let mut shared = 0;
     let (mut fi, mut gj) = ([0usize; 3], [0usize; 3]);
     for i in 0..3 {
         for j in 0..3 {
-            if f.v[i] == g.v[j] {
+            if f[i] == g[j] {
                 fi[shared] = i;
                 gj[shared] = j;
                 shared += 1;
             }
         }
     }
-    // A shared vertex of `f` whose star bit is set: both facets lie in its fan, which projects
-    // one-to-one, so they meet only in what they share (the vertex, or an edge from it).
-    let starred = |k: usize| f.star & (1 << fi[k]) != 0;
+    (shared, fi, gj)
+}
+
+/// Whether the pair of facets with vertex indices `f` and `g` is answered without looking at
+/// their corners: duplicates (three shared vertices), and pairs sharing a vertex that `f_star`
+/// (bit k for corner k of `f`) marks as a vertex whose facets hold no intersecting pair among
+/// those sharing it (see [`super::fans`]): both facets lie in its fan, which projects one-to-one,
+/// so they meet only in what they share (the vertex, or an edge from it).
+#[inline]
+pub fn settled_by_sharing(f: &[u32; 3], f_star: u8, g: &[u32; 3]) -> bool {
+    let (shared, fi, _) = sharing(f, g);
+    match shared {
+        0 => false,
+        1 => f_star & (1 << fi[0]) != 0,
+        2 => f_star & (1 << fi[0] | 1 << fi[1]) != 0,
+        _ => true,
+    }
+}
+
+/// Whether facets `f` and `g` (neither degenerate) intersect in more than the vertices and edge
+/// they share — CGAL's `do_faces_intersect`, with sharing read off the vertex indices. Facets
+/// sharing all three vertices (duplicates) are not counted here: `check` reports them as
+/// duplicate facets.
+pub fn facets_intersect(f: &Facet, g: &Facet) -> bool {
+    let (shared, fi, gj) = sharing(&f.v, &g.v);
     match shared {
         0 => facets_meet(f, g),
-        1 if starred(0) => false,
         1 => {
             // The edges opposite the shared vertex, each against the other triangle.
             let (i, j) = (fi[0], gj[0]);
             segment_meets_facet(f, &g.p[(j + 1) % 3], &g.p[(j + 2) % 3])
                 || segment_meets_facet(g, &f.p[(i + 1) % 3], &f.p[(i + 2) % 3])
         }
-        2 if starred(0) || starred(1) => false,
         2 => {
             // A shared edge u–v: a fold when the third vertices are coplanar with it and on one
             // side of it.

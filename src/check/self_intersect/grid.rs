@@ -16,7 +16,7 @@
 //! Cells are grouped into bricks of 16³ searched in parallel, each with its own counting sort of
 //! its facets into cells, so the memory beyond the mesh is a few bytes per facet.
 
-use super::exact::{collinear, facets_intersect, Facet, P};
+use super::exact::{collinear, facets_intersect, settled_by_sharing, Facet, P};
 use crate::progress::Progress;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
@@ -221,6 +221,7 @@ pub fn intersecting_pairs(
         ]
         .map(|x| x << BRICK_SHIFT);
         let mut local = Vec::new();
+        let stars_of = |t: [u32; 3]| (0..3).fold(0u8, |m, k| m | (star[t[k] as usize] as u8) << k);
         // Natives sorted by their boxes' lower x, so that each cell's list is too (the counting
         // sort is stable) and a facet's partners in a cell end at the first box starting past
         // its own. Degenerate ones are reported in the brick of their box's lower corner.
@@ -242,7 +243,7 @@ pub fn intersecting_pairs(
                 }
                 continue;
             }
-            natives.push(id, Facet::new(t, p).with_star(star), b, c);
+            natives.push(id, t, stars_of(t), b, c);
         }
         let mut queries = Members::default();
         for &id in &bucket.queries {
@@ -250,7 +251,7 @@ pub fn intersecting_pairs(
             let p = t.map(point);
             if !collinear(&p[0], &p[1], &p[2]) {
                 let b = bbox(&t);
-                queries.push(id, Facet::new(t, p).with_star(star), b, cells(&b, level));
+                queries.push(id, t, stars_of(t), b, cells(&b, level));
             }
         }
         let nat_cells = sort_into_cells(&natives.cells, base);
@@ -271,7 +272,12 @@ pub fn intersecting_pairs(
             if u[0].max(v[0]) != cell[0] || u[1].max(v[1]) != cell[1] || u[2].max(v[2]) != cell[2] {
                 return;
             }
-            if facets_intersect(&a.facets[i], &b.facets[j]) {
+            // Most pairs share a vertex of a proven fan: their corners are not even read.
+            if settled_by_sharing(&a.verts[i], a.stars[i], &b.verts[j]) {
+                return;
+            }
+            let facet = |t: [u32; 3]| Facet::new(t, t.map(point));
+            if facets_intersect(&facet(a.verts[i]), &facet(b.verts[j])) {
                 let (f, g) = (a.ids[i], b.ids[j]);
                 local.push((f.min(g), f.max(g)));
             }
@@ -315,22 +321,25 @@ pub fn intersecting_pairs(
     pairs
 }
 
-/// The facets of a brick: the boxes and cells the broad phase scans apart from the facets the
-/// exact tests read.
+/// The facets of a brick, as the broad phase scans them: ids, boxes, cells, vertex indices and
+/// star bits (bit k: corner k's vertex is proven, see [`super::fans`]). The corners are read only
+/// for the pairs that need the exact tests.
 #[derive(Default)]
 struct Members {
     ids: Vec<u32>,
     boxes: Vec<[[f32; 3]; 2]>,
     cells: Vec<[[i32; 3]; 2]>,
-    facets: Vec<Facet>,
+    verts: Vec<[u32; 3]>,
+    stars: Vec<u8>,
 }
 
 impl Members {
-    fn push(&mut self, id: u32, f: Facet, b: [[f32; 3]; 2], c: [[i64; 3]; 2]) {
+    fn push(&mut self, id: u32, t: [u32; 3], stars: u8, b: [[f32; 3]; 2], c: [[i64; 3]; 2]) {
         self.ids.push(id);
         self.boxes.push(b);
         self.cells.push(c.map(|x| x.map(|v| v as i32)));
-        self.facets.push(f);
+        self.verts.push(t);
+        self.stars.push(stars);
     }
 }
 
