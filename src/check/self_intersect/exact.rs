@@ -416,9 +416,9 @@ fn coplanar_segment_meets_triangle(aa: &P, bb: &P, cc: &P, p: &P, q: &P) -> bool
 pub fn sharing(f: &[u32; 3], g: &[u32; 3]) -> (usize, [usize; 3], [usize; 3]) {
     let mut shared = 0;
     let (mut fi, mut gj) = ([0usize; 3], [0usize; 3]);
-    for i in 0..3 {
-        for j in 0..3 {
-            if f[i] == g[j] {
+    for (i, a) in f.iter().enumerate() {
+        for (j, b) in g.iter().enumerate() {
+            if a == b {
                 fi[shared] = i;
                 gj[shared] = j;
                 shared += 1;
