@@ -84,9 +84,10 @@ pub fn verify(mesh: &Mesh, how: Verify, progress: &Progress) -> Result<Verificat
                     soup_self_intersections_shown(mesh, &all, 0, stars, progress).0
                 },
             );
+            // A search of fewer than two facets asks for no star vertices.
             let fans = fans
                 .into_inner()
-                .expect("the search asks for the star vertices");
+                .unwrap_or_else(|| vertex_fans(mesh, false));
             Ok(verification(mesh, how, assemble(&fans, &m), Some(pairs)))
         }
         Verify::Fast => Ok(verification(mesh, how, topology(mesh), None)),
@@ -395,6 +396,23 @@ mod tests {
         assert_eq!(t.border_edges, 0);
         assert!((t.volume - 1.0 / 6.0).abs() < 1e-12);
         assert_eq!(t.components, 1);
+    }
+
+    #[test]
+    fn meshes_of_no_facet_or_one_are_verified_in_full() {
+        let one = Mesh {
+            positions: vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+            indices: vec![0, 1, 2],
+        };
+        let v = verify(&one, Verify::Full, &Progress::hidden()).unwrap();
+        assert!(!v.closed && v.manifold && !v.self_intersecting, "{v:?}");
+        assert_eq!(v.border_edges, 3);
+        let none = Mesh {
+            positions: vec![],
+            indices: vec![],
+        };
+        let v = verify(&none, Verify::Full, &Progress::hidden()).unwrap();
+        assert!(!v.self_intersecting && v.faces == 0, "{v:?}");
     }
 
     #[test]
