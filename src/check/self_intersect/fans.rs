@@ -168,18 +168,50 @@ pub fn star_vertices(positions: &[f32], tris: &[[u32; 3]]) -> Vec<bool> {
         .collect()
 }
 
-/// Whether `v` qualifies (see the module's text).
+/// Whether `v` qualifies (see the module's text): its fan sound and closed, and projecting
+/// one-to-one.
 fn star(links: &Links, v: usize) -> bool {
-    let link = links.of(v);
-    // One link edge starting and one ending at each neighbour.
-    for e in link {
-        if link.iter().filter(|f| f[0] == e[0]).count() != 1
-            || link.iter().filter(|f| f[1] == e[0]).count() != 1
-        {
-            return false;
+    links.of(v).len() >= 3 && fan(links.of(v)) == (false, 0) && links.projects_one_to_one(v)
+}
+
+/// Checks one vertex's link edges `b → c`: returns (defective, border half-edges). The fan is
+/// sound when no vertex starts two link edges or ends two (each edge from the vertex traversed
+/// once each way), and the link edges chain into one cycle, or one path where the fan meets a
+/// border. A half-edge v → b without its twin b → v is a border half-edge (the link edge that
+/// starts at b has no link edge ending at b).
+pub fn fan(link: &[[u32; 2]]) -> (bool, u64) {
+    let n = link.len();
+    let starts_at = |x: u32| link.iter().filter(|e| e[0] == x).count();
+    let ends_at = |x: u32| link.iter().filter(|e| e[1] == x).count();
+    let mut border = 0u64;
+    let mut bad = false;
+    let mut path_start = None;
+    for &[b, c] in link {
+        if starts_at(b) != 1 || ends_at(c) != 1 {
+            bad = true;
+        }
+        if ends_at(b) == 0 {
+            border += 1;
+            if path_start.replace(b).is_some() {
+                bad = true; // two border paths meet here
+            }
         }
     }
-    links.projects_one_to_one(v)
+    if bad {
+        return (true, border);
+    }
+    // Walk the chain from the path's start (or anywhere on a cycle); it must cover every facet.
+    let first = path_start.unwrap_or(link[0][0]);
+    let mut at = first;
+    let mut steps = 0;
+    while let Some(&[_, c]) = link.iter().find(|e| e[0] == at) {
+        steps += 1;
+        at = c;
+        if at == first || steps > n {
+            break;
+        }
+    }
+    (steps != n, border)
 }
 
 #[cfg(test)]
