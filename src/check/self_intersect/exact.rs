@@ -435,13 +435,11 @@ pub fn sharing(f: &[u32; 3], g: &[u32; 3]) -> (usize, [usize; 3], [usize; 3]) {
 /// so they meet only in what they share (the vertex, or an edge from it).
 #[inline]
 pub fn settled_by_sharing(f: &[u32; 3], f_star: u8, g: &[u32; 3]) -> bool {
-    let (shared, fi, _) = sharing(f, g);
-    match shared {
-        0 => false,
-        1 => f_star & (1 << fi[0]) != 0,
-        2 => f_star & (1 << fi[0] | 1 << fi[1]) != 0,
-        _ => true,
-    }
+    // Bit i: corner i of f is a vertex of g.
+    let shared = (0..3).fold(0u8, |m, i| {
+        m | ((f[i] == g[0]) as u8 | (f[i] == g[1]) as u8 | (f[i] == g[2]) as u8) << i
+    });
+    shared == 7 || f_star & shared != 0
 }
 
 /// Whether facets `f` and `g` (neither degenerate) intersect in more than the vertices and edge

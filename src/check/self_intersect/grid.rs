@@ -225,13 +225,13 @@ pub fn intersecting_pairs(
         // Natives sorted by their boxes' lower x, so that each cell's list is too (the counting
         // sort is stable) and a facet's partners in a cell end at the first box starting past
         // its own. Degenerate ones are reported in the brick of their box's lower corner.
-        let mut natives = Members::default();
         let mut order: Vec<(f32, u32)> = bucket
             .natives
             .iter()
             .map(|&i| (bbox(&tris[i as usize])[0][0], i))
             .collect();
         order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        let mut natives = Vec::with_capacity(order.len());
         for (_, id) in order {
             let t = tris[id as usize];
             let p = t.map(point);
@@ -243,44 +243,43 @@ pub fn intersecting_pairs(
                 }
                 continue;
             }
-            natives.push(id, t, stars_of(t), b, c);
+            natives.push(Member::new(id, t, stars_of(t), b, c, base));
         }
-        let mut queries = Members::default();
-        for &id in &bucket.queries {
-            let t = tris[id as usize];
-            let p = t.map(point);
-            if !collinear(&p[0], &p[1], &p[2]) {
+        let queries: Vec<Member> = bucket
+            .queries
+            .iter()
+            .filter_map(|&id| {
+                let t = tris[id as usize];
+                let p = t.map(point);
                 let b = bbox(&t);
-                queries.push(id, t, stars_of(t), b, cells(&b, level));
-            }
-        }
-        let nat_cells = sort_into_cells(&natives.cells, base);
-        let qry_cells = sort_into_cells(&queries.cells, base);
-        let mut test = |a: &Members, i: usize, b: &Members, j: usize, cell: [i32; 3]| {
-            let (x, y) = (&a.boxes[i], &b.boxes[j]);
-            if !(x[0][1] <= y[1][1]
-                && y[0][1] <= x[1][1]
-                && x[0][2] <= y[1][2]
-                && y[0][2] <= x[1][2]
-                && x[0][0] <= y[1][0]
-                && y[0][0] <= x[1][0])
-            {
-                return;
-            }
-            // Tested only in the cell of the lowest corner of the boxes' intersection.
-            let (u, v) = (&a.cells[i][0], &b.cells[j][0]);
-            if u[0].max(v[0]) != cell[0] || u[1].max(v[1]) != cell[1] || u[2].max(v[2]) != cell[2] {
-                return;
-            }
+                (!collinear(&p[0], &p[1], &p[2]))
+                    .then(|| Member::new(id, t, stars_of(t), b, cells(&b, level), base))
+            })
+            .collect();
+        let nat_cells = sort_into_cells(&natives);
+        let qry_cells = sort_into_cells(&queries);
+        let mut test = |a: &Member, b: &Member| {
             // Most pairs share a vertex of a proven fan: their corners are not even read.
-            if settled_by_sharing(&a.verts[i], a.stars[i], &b.verts[j]) {
+            if settled_by_sharing(&a.verts, a.stars, &b.verts) {
                 return;
             }
             let facet = |t: [u32; 3]| Facet::new(t, t.map(point));
-            if facets_intersect(&facet(a.verts[i]), &facet(b.verts[j])) {
-                let (f, g) = (a.ids[i], b.ids[j]);
+            if facets_intersect(&facet(a.verts), &facet(b.verts)) {
+                let (f, g) = (a.id, b.id);
                 local.push((f.min(g), f.max(g)));
             }
+        };
+        // A cell's members, copied side by side with their corner masks: bit `a` when the
+        // member's lowest cell is this one on axis `a`. A pair is tested only in the cell of the
+        // lowest corner of its boxes' intersection: where the two masks cover all three axes.
+        let (mut here, mut asked) = (Vec::new(), Vec::new());
+        let gather = |out: &mut Vec<Member>, all: &[Member], ids: &[u32], cell: [i8; 3]| {
+            out.clear();
+            out.extend(ids.iter().map(|&i| {
+                let mut m = all[i as usize];
+                m.mask = (0..3).fold(0, |k, a| k | ((m.lo_cell[a] == cell[a]) as u8) << a);
+                m
+            }));
         };
         for c in 0..BRICK * BRICK * BRICK {
             let n = &nat_cells.1[nat_cells.0[c] as usize..nat_cells.0[c + 1] as usize];
@@ -288,23 +287,36 @@ pub fn intersecting_pairs(
                 continue;
             }
             let cell = [
-                base[0] as i32 + (c / (BRICK * BRICK)) as i32,
-                base[1] as i32 + ((c / BRICK) % BRICK) as i32,
-                base[2] as i32 + (c % BRICK) as i32,
+                (c / (BRICK * BRICK)) as i8,
+                ((c / BRICK) % BRICK) as i8,
+                (c % BRICK) as i8,
             ];
-            for (k, &i) in n.iter().enumerate() {
-                let hi_x = natives.boxes[i as usize][1][0];
-                for &j in &n[k + 1..] {
-                    if natives.boxes[j as usize][0][0] > hi_x {
+            gather(&mut here, &natives, n, cell);
+            for (k, a) in here.iter().enumerate() {
+                for b in &here[k + 1..] {
+                    // Sorted by lower x: the boxes overlap along x until b starts past a.
+                    if b.lo[0] > a.hi[0] {
                         break;
                     }
-                    test(&natives, i as usize, &natives, j as usize, cell);
+                    if a.mask | b.mask == 7 && a.overlaps_yz(b) {
+                        test(a, b);
+                    }
                 }
             }
             let q = &qry_cells.1[qry_cells.0[c] as usize..qry_cells.0[c + 1] as usize];
-            for &i in q {
-                for &j in n {
-                    test(&queries, i as usize, &natives, j as usize, cell);
+            if q.is_empty() {
+                continue;
+            }
+            gather(&mut asked, &queries, q, cell);
+            for a in &asked {
+                for b in &here {
+                    if a.mask | b.mask == 7
+                        && a.lo[0] <= b.hi[0]
+                        && b.lo[0] <= a.hi[0]
+                        && a.overlaps_yz(b)
+                    {
+                        test(a, b);
+                    }
                 }
             }
         }
@@ -321,25 +333,52 @@ pub fn intersecting_pairs(
     pairs
 }
 
-/// The facets of a brick, as the broad phase scans them: ids, boxes, cells, vertex indices and
-/// star bits (bit k: corner k's vertex is proven, see [`super::fans`]). The corners are read only
-/// for the pairs that need the exact tests.
-#[derive(Default)]
-struct Members {
-    ids: Vec<u32>,
-    boxes: Vec<[[f32; 3]; 2]>,
-    cells: Vec<[[i32; 3]; 2]>,
-    verts: Vec<[u32; 3]>,
-    stars: Vec<u8>,
+/// A facet of a brick, as the broad phase scans it: its box, its cells (relative to the brick's,
+/// clamped), vertex indices, star bits (bit k: corner k's vertex is proven, see
+/// [`super::fans`]) and id. The corners are read only for the pairs that need the exact tests.
+#[derive(Clone, Copy)]
+struct Member {
+    lo: [f32; 3],
+    hi: [f32; 3],
+    verts: [u32; 3],
+    id: u32,
+    lo_cell: [i8; 3],
+    hi_cell: [i8; 3],
+    stars: u8,
+    /// Per cell scanned: the axes on which the lowest cell is that cell.
+    mask: u8,
 }
 
-impl Members {
-    fn push(&mut self, id: u32, t: [u32; 3], stars: u8, b: [[f32; 3]; 2], c: [[i64; 3]; 2]) {
-        self.ids.push(id);
-        self.boxes.push(b);
-        self.cells.push(c.map(|x| x.map(|v| v as i32)));
-        self.verts.push(t);
-        self.stars.push(stars);
+impl Member {
+    fn new(
+        id: u32,
+        verts: [u32; 3],
+        stars: u8,
+        b: [[f32; 3]; 2],
+        c: [[i64; 3]; 2],
+        base: [i64; 3],
+    ) -> Member {
+        // Within the brick a facet's cells run from -2 to 17; anything further is clamped
+        // (it equals no cell of the brick either way).
+        let rel = |x: [i64; 3]| [0, 1, 2].map(|a| (x[a] - base[a]).clamp(-64, 64) as i8);
+        Member {
+            lo: b[0],
+            hi: b[1],
+            verts,
+            id,
+            lo_cell: rel(c[0]),
+            hi_cell: rel(c[1]),
+            stars,
+            mask: 0,
+        }
+    }
+
+    #[inline]
+    fn overlaps_yz(&self, o: &Member) -> bool {
+        self.lo[1] <= o.hi[1]
+            && o.lo[1] <= self.hi[1]
+            && self.lo[2] <= o.hi[2]
+            && o.lo[2] <= self.hi[2]
     }
 }
 
@@ -430,14 +469,14 @@ fn for_each_brick(c: [[i64; 3]; 2], f: impl FnMut([i64; 3])) {
     for_each_cell([c[0].map(|x| x >> s), c[1].map(|x| x >> s)], f);
 }
 
-/// A counting sort of facets (by their `cells` ranges) into the cells of the brick at `base`:
-/// cell `c`'s facets are `list[starts[c]..starts[c + 1]]` (positions in `cells`).
-fn sort_into_cells(cells: &[[[i32; 3]; 2]], base: [i64; 3]) -> (Vec<u32>, Vec<u32>) {
+/// A counting sort of a brick's members into its cells: cell `c`'s members are
+/// `list[starts[c]..starts[c + 1]]` (positions in `members`, in their order).
+fn sort_into_cells(members: &[Member]) -> (Vec<u32>, Vec<u32>) {
     let n = BRICK * BRICK * BRICK;
-    let base = base.map(|x| x as i32);
-    let local = |m: &[[i32; 3]; 2], f: &mut dyn FnMut(usize)| {
-        let lo = [0, 1, 2].map(|i| (m[0][i] - base[i]).max(0) as usize);
-        let hi = [0, 1, 2].map(|i| (m[1][i] - base[i]).min(BRICK as i32 - 1) as usize);
+    let last = BRICK as i8 - 1;
+    let local = |m: &Member, f: &mut dyn FnMut(usize)| {
+        let lo = m.lo_cell.map(|x| x.max(0) as usize);
+        let hi = m.hi_cell.map(|x| x.min(last) as usize);
         for x in lo[0]..=hi[0] {
             for y in lo[1]..=hi[1] {
                 for z in lo[2]..=hi[2] {
@@ -447,7 +486,7 @@ fn sort_into_cells(cells: &[[[i32; 3]; 2]], base: [i64; 3]) -> (Vec<u32>, Vec<u3
         }
     };
     let mut starts = vec![0u32; n + 1];
-    for m in cells {
+    for m in members {
         local(m, &mut |c| starts[c + 1] += 1);
     }
     for c in 0..n {
@@ -455,7 +494,7 @@ fn sort_into_cells(cells: &[[[i32; 3]; 2]], base: [i64; 3]) -> (Vec<u32>, Vec<u3
     }
     let mut fill = starts.clone();
     let mut list = vec![0u32; starts[n] as usize];
-    for (k, m) in cells.iter().enumerate() {
+    for (k, m) in members.iter().enumerate() {
         local(m, &mut |c| {
             list[fill[c] as usize] = k as u32;
             fill[c] += 1;
