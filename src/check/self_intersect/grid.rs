@@ -225,14 +225,8 @@ pub fn intersecting_pairs(
         // Natives sorted by their boxes' lower x, so that each cell's list is too (the counting
         // sort is stable) and a facet's partners in a cell end at the first box starting past
         // its own. Degenerate ones are reported in the brick of their box's lower corner.
-        let mut order: Vec<(f32, u32)> = bucket
-            .natives
-            .iter()
-            .map(|&i| (bbox(&tris[i as usize])[0][0], i))
-            .collect();
-        order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-        let mut natives = Vec::with_capacity(order.len());
-        for (_, id) in order {
+        let mut natives = Vec::with_capacity(bucket.natives.len());
+        for &id in &bucket.natives {
             let t = tris[id as usize];
             let p = t.map(point);
             let b = bbox(&t);
@@ -245,6 +239,7 @@ pub fn intersecting_pairs(
             }
             natives.push(Member::new(id, t, stars_of(t), b, c, base));
         }
+        natives.sort_unstable_by(|a, b| a.lo[0].total_cmp(&b.lo[0]));
         let queries: Vec<Member> = bucket
             .queries
             .iter()
