@@ -105,26 +105,48 @@ impl Measures {
 }
 
 /// Streams STL into a temporary file beside `path`; [`StlSink::commit`] renames it into place.
+///
+/// Binary STL has fixed-size records, so each batch is serialized and written at its offset in
+/// pieces by several threads at once (positional writes): the copy into the page cache, as
+/// costly as the serialization on a large part, overlaps it instead of waiting for it. (Measured
+/// on a 16 M-triangle part, 2 cores: faster than one buffered stream, and than a writer thread
+/// fed the serialized batches.)
 pub struct StlSink {
     path: PathBuf,
     format: StlFormat,
     tmp: Option<tempfile::NamedTempFile>,
+    file: std::fs::File,
+    /// ASCII only: the buffered stream.
     out: Option<std::io::BufWriter<std::fs::File>>,
     written: u64,
     announced: Option<u64>,
     buf: Vec<u8>,
 }
 
+/// Binary STL: the header's length and each record's.
+const STL_HEADER: u64 = 84;
+const STL_RECORD: usize = 50;
+/// Records serialized and written per piece.
+const RECORDS_PER_WRITE: usize = 1 << 16;
+
 impl StlSink {
     /// Opens the temporary file (the destination folder must be writable).
     pub fn create(path: &Path, format: StlFormat) -> Result<StlSink> {
         let tmp = crate::io::atomic::temp_beside(path)?;
         let file = tmp.reopen().map_err(|e| Error::io(path, e))?;
+        let out = match format {
+            StlFormat::Ascii => Some(std::io::BufWriter::with_capacity(
+                1 << 22,
+                file.try_clone().map_err(|e| Error::io(path, e))?,
+            )),
+            StlFormat::Binary => None,
+        };
         Ok(StlSink {
             path: path.to_path_buf(),
             format,
             tmp: Some(tmp),
-            out: Some(std::io::BufWriter::with_capacity(1 << 22, file)),
+            file,
+            out,
             written: 0,
             announced: None,
             buf: Vec::new(),
@@ -136,7 +158,7 @@ impl StlSink {
     }
 
     fn writer(&mut self) -> &mut std::io::BufWriter<std::fs::File> {
-        self.out.as_mut().expect("STL sink used after commit")
+        self.out.as_mut().expect("ASCII STL sink used after commit")
     }
 
     /// Moves the finished file into place.
@@ -148,6 +170,17 @@ impl StlSink {
         tmp.persist(&self.path)
             .map_err(|e| Error::io(&self.path, e.error))?;
         Ok(())
+    }
+
+    /// Writes `count` as the binary file's triangle count.
+    fn write_count(&self, count: u64) -> Result<()> {
+        use std::os::unix::fs::FileExt;
+        let count = u32::try_from(count).map_err(|_| {
+            Error::invalid("more than 2^32 triangles cannot be written as binary STL")
+        })?;
+        self.file
+            .write_all_at(&count.to_le_bytes(), 80)
+            .map_err(|e| self.io(e))
     }
 }
 
@@ -163,46 +196,60 @@ fn unit_normal(t: &Triangle) -> [f32; 3] {
     }
 }
 
+/// The binary STL record of `t`.
+fn stl_record(t: &Triangle, rec: &mut [u8]) {
+    let n = unit_normal(t);
+    let vals = n.iter().chain(t.iter().flatten());
+    for (k, v) in vals.enumerate() {
+        rec[4 * k..4 * k + 4].copy_from_slice(&v.to_le_bytes());
+    }
+    rec[48] = 0;
+    rec[49] = 0;
+}
+
 impl MeshSink for StlSink {
     fn begin(&mut self, triangles: Option<u64>) -> Result<()> {
+        use std::os::unix::fs::FileExt;
         self.announced = triangles;
-        let r = match self.format {
+        match self.format {
             StlFormat::Binary => {
                 let mut header = [b' '; 80];
                 let tag = b"binary STL written by latvox";
                 header[..tag.len()].copy_from_slice(tag);
-                let count = u32::try_from(triangles.unwrap_or(0)).map_err(|_| {
-                    Error::invalid("more than 2^32 triangles cannot be written as binary STL")
-                })?;
-                let w = self.writer();
-                w.write_all(&header)
-                    .and_then(|_| w.write_all(&count.to_le_bytes()))
+                let r = self.file.write_all_at(&header, 0);
+                r.map_err(|e| self.io(e))?;
+                self.write_count(triangles.unwrap_or(0))
             }
-            StlFormat::Ascii => writeln!(self.writer(), "solid latvox"),
-        };
-        r.map_err(|e| self.io(e))
+            StlFormat::Ascii => {
+                let r = writeln!(self.writer(), "solid latvox");
+                r.map_err(|e| self.io(e))
+            }
+        }
     }
 
     fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
+        let first = self.written;
         self.written += batch.len() as u64;
-        let mut buf = std::mem::take(&mut self.buf);
-        buf.clear();
         match self.format {
             StlFormat::Binary => {
-                buf.resize(batch.len() * 50, 0);
-                buf.par_chunks_mut(50)
-                    .zip(batch.par_iter())
-                    .for_each(|(rec, t)| {
-                        let n = unit_normal(t);
-                        let vals = n.iter().chain(t.iter().flatten());
-                        for (k, v) in vals.enumerate() {
-                            rec[4 * k..4 * k + 4].copy_from_slice(&v.to_le_bytes());
+                use std::os::unix::fs::FileExt;
+                let file = &self.file;
+                batch
+                    .par_chunks(RECORDS_PER_WRITE)
+                    .enumerate()
+                    .try_for_each_init(Vec::new, |bytes, (k, chunk)| {
+                        bytes.resize(chunk.len() * STL_RECORD, 0);
+                        for (rec, t) in bytes.chunks_exact_mut(STL_RECORD).zip(chunk) {
+                            stl_record(t, rec);
                         }
-                        rec[48] = 0;
-                        rec[49] = 0;
-                    });
+                        let record = first + (k * RECORDS_PER_WRITE) as u64;
+                        file.write_all_at(bytes, STL_HEADER + STL_RECORD as u64 * record)
+                    })
+                    .map_err(|e| self.io(e))
             }
             StlFormat::Ascii => {
+                let mut buf = std::mem::take(&mut self.buf);
+                buf.clear();
                 for t in batch {
                     let n = unit_normal(t);
                     let _ = writeln!(buf, "  facet normal {:e} {:e} {:e}", n[0], n[1], n[2]);
@@ -213,33 +260,27 @@ impl MeshSink for StlSink {
                     let _ = writeln!(buf, "    endloop");
                     let _ = writeln!(buf, "  endfacet");
                 }
+                let r = self.writer().write_all(&buf);
+                self.buf = buf;
+                r.map_err(|e| self.io(e))
             }
         }
-        let r = self.writer().write_all(&buf);
-        self.buf = buf;
-        r.map_err(|e| self.io(e))
     }
 
     fn finish(&mut self) -> Result<()> {
-        if self.format == StlFormat::Ascii {
-            let r = writeln!(self.writer(), "endsolid latvox");
-            r.map_err(|e| self.io(e))?;
-        } else if self.announced != Some(self.written) {
+        match self.format {
+            StlFormat::Ascii => {
+                let r = writeln!(self.writer(), "endsolid latvox");
+                r.map_err(|e| self.io(e))?;
+                let r = self.writer().flush();
+                r.map_err(|e| self.io(e))
+            }
             // The count was not known up front: patch it into the header.
-            use std::io::{Seek, SeekFrom};
-            let count = u32::try_from(self.written).map_err(|_| {
-                Error::invalid("more than 2^32 triangles cannot be written as binary STL")
-            })?;
-            let w = self.writer();
-            let r = w
-                .flush()
-                .and_then(|_| w.get_mut().seek(SeekFrom::Start(80)))
-                .and_then(|_| w.get_mut().write_all(&count.to_le_bytes()))
-                .and_then(|_| w.get_mut().seek(SeekFrom::End(0)).map(drop));
-            r.map_err(|e| self.io(e))?;
+            StlFormat::Binary if self.announced != Some(self.written) => {
+                self.write_count(self.written)
+            }
+            StlFormat::Binary => Ok(()),
         }
-        let r = self.writer().flush();
-        r.map_err(|e| self.io(e))
     }
 }
 
