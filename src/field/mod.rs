@@ -26,14 +26,7 @@ pub trait Field: Sync {
     /// sign as `value`, smooth near the surface (used for Newton projection onto the surface).
     /// The default differentiates `value` numerically.
     fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
-        let e = 1e-6 * (1.0 + p.iter().fold(0.0f64, |m, x| m.max(x.abs())));
-        let g = [0, 1, 2].map(|a| {
-            let (mut up, mut dn) = (p, p);
-            up[a] += e;
-            dn[a] -= e;
-            (self.value(up) - self.value(dn)) / (2.0 * e)
-        });
-        (self.value(p), g)
+        (self.value(p), numeric_gradient(|q| self.value(q), p))
     }
 
     /// Values at the 8³ points `origin + h·(i, j, k)`, `i, j, k ∈ 0..8`, stored at
@@ -68,6 +61,17 @@ impl<T: Field + ?Sized> Field for &T {
     fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
         (**self).sample_block(origin, h, out)
     }
+}
+
+/// The gradient of `f` at `p` by central differences, with a step relative to `p`'s size.
+pub fn numeric_gradient(f: impl Fn(Vec3) -> f64, p: Vec3) -> Vec3 {
+    let e = 1e-6 * (1.0 + p.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+    [0, 1, 2].map(|a| {
+        let (mut up, mut dn) = (p, p);
+        up[a] += e;
+        dn[a] -= e;
+        (f(up) - f(dn)) / (2.0 * e)
+    })
 }
 
 /// Quilez's polynomial smooth minimum of radius `k > 0`: `min(a, b)` where they differ by more
