@@ -1,6 +1,6 @@
 //! Strut lattices made by the library's strut job (what `latvox strut` runs): each built-in cell in 10×10×10 cells of 5 mm at density 0.2, 32 voxels per cell, its radius
-//! found on a template of its cells, the part copied from the template into a binary STL, with
-//! CGAL's checks (self-intersection included). Printed: wall time in this process, meshings of
+//! found on a template of its cells, the part copied from the template into a binary STL, the
+//! template verified in full (self-intersection included). Printed: wall time in this process, meshings of
 //! the search, achieved density, triangles, and the process's peak resident memory so far.
 //!
 //! Run: `cargo bench --bench strut` (add `-- CELL` to run one cell); `-- --scale N` for the
@@ -58,7 +58,7 @@ fn main() {
     let only: Option<String> = std::env::args().skip(1).find(|a| !a.starts_with('-'));
     let dir = tempfile::tempdir().unwrap();
     let domain = Domain::from_cells([10; 3], [5.0; 3], [0.0; 3]).unwrap();
-    println!("10x10x10 cells of 5 mm, density 0.2, 32 voxels per cell, STL with CGAL's checks:");
+    println!("10x10x10 cells of 5 mm, density 0.2, 32 voxels per cell, STL, template verified:");
     for name in latvox::strut::cell::BUILT_IN {
         if only.as_deref().is_some_and(|o| o != name) {
             continue;
@@ -78,11 +78,14 @@ fn main() {
                 ..Default::default()
             },
         };
-        let out = dir.path().join("s.stl");
+        // A new file each time: replacing the last part's hundreds of megabytes would time the
+        // file system's freeing them.
+        let out = dir.path().join(format!("{name}.stl"));
         let mut sink = MeshFile::new(&out, false).unwrap().sink().unwrap();
         let r = job.run_into(&Progress::hidden(), &mut sink).unwrap();
         sink.commit().unwrap();
         let wall = t.elapsed().as_secs_f64();
+        std::fs::remove_file(&out).unwrap();
         let p = &r.part;
         println!(
             "  {name:8} radius {:.4} mm, {} meshing(s), density {:.4}, {} triangles, valid {}: wall {wall:.2} s (model {:.2}, sample {:.2}, mesh {:.2}, snap {:.2}, verify {:.2}, write {:.2}), peak RSS so far {:.0} MB",
