@@ -127,6 +127,13 @@ pub fn template_bounds(part: &Aabb, cell: Vec3, plan: &[AxisPlan; 3]) -> Aabb {
     b
 }
 
+/// A template cell's triangles by local vertex (see [`Template::kind_tables`]).
+#[derive(Default)]
+struct KindTable {
+    vertices: Vec<u32>,
+    triangles: Vec<[u32; 3]>,
+}
+
 /// A meshed template and what is needed to copy it.
 pub struct Template {
     /// How each axis of the part maps onto the template.
@@ -421,6 +428,7 @@ impl Template {
             ]
         };
         let kind_of = |c: [i64; 3]| self.kind_index([0, 1, 2].map(|a| self.plan[a].kind(c[a])));
+        let kinds = self.kind_tables();
         sink.begin(Some(self.triangle_count()))?;
         let mut measures = Measures::default();
         // Batches of about a million triangles: both cores stay busy, memory stays bounded, and
@@ -445,7 +453,7 @@ impl Template {
             }
             let parts: Vec<Result<Measures>> = slices
                 .into_par_iter()
-                .map(|(i, out)| self.cell_triangles(cell_at(i), out))
+                .map(|(i, out)| self.cell_triangles(cell_at(i), &kinds, out))
                 .collect();
             for m in parts {
                 measures = measures.merged(&m?);
@@ -466,8 +474,38 @@ impl Template {
         }
     }
 
+    /// Per template cell: the vertices its triangles use, each once, and its triangles (in quad
+    /// order) as indices into that list — so a copied cell places each vertex once, not once
+    /// per triangle around it.
+    fn kind_tables(&self) -> Vec<KindTable> {
+        self.quads_by_cell
+            .par_iter()
+            .map(|qs| {
+                let mut local: HashMap<u32, u32> = HashMap::new();
+                let mut table = KindTable::default();
+                for &q in qs {
+                    let (t, u) = self.mesh.quad_triangles(q as usize);
+                    for tri in std::iter::once(t).chain(u) {
+                        table.triangles.push(tri.map(|v| {
+                            *local.entry(v).or_insert_with(|| {
+                                table.vertices.push(v);
+                                table.vertices.len() as u32 - 1
+                            })
+                        }));
+                    }
+                }
+                table
+            })
+            .collect()
+    }
+
     /// Writes the triangles of the part's cell `c` into `out` (sized for them) and measures them.
-    fn cell_triangles(&self, c: [i64; 3], out: &mut [Triangle]) -> Result<Measures> {
+    fn cell_triangles(
+        &self,
+        c: [i64; 3],
+        kinds: &[KindTable],
+        out: &mut [Triangle],
+    ) -> Result<Measures> {
         let kind = [0, 1, 2].map(|a| self.plan[a].kind(c[a]));
         // For each neighbour offset d ∈ {−1, 0, 1}³ of a corner's template cell from this cell's
         // kind: per axis, whether the twin is needed, and the translation in cells.
@@ -512,16 +550,14 @@ impl Template {
             let p = tpos[j as usize];
             Ok([0, 1, 2].map(|a| (p[a] + shift[di][a]) as f32))
         };
-        let quads = &self.quads_by_cell[self.kind_index(kind)];
-        let mut k = 0;
-        for &q in quads {
-            let (t, u) = self.mesh.quad_triangles(q as usize);
-            out[k] = [corner(t[0])?, corner(t[1])?, corner(t[2])?];
-            k += 1;
-            if let Some(u) = u {
-                out[k] = [corner(u[0])?, corner(u[1])?, corner(u[2])?];
-                k += 1;
-            }
+        let table = &kinds[self.kind_index(kind)];
+        let placed: Vec<[f32; 3]> = table
+            .vertices
+            .iter()
+            .map(|&v| corner(v))
+            .collect::<Result<_>>()?;
+        for (o, t) in out.iter_mut().zip(&table.triangles) {
+            *o = t.map(|i| placed[i as usize]);
         }
         Ok(Measures::of_serial(out))
     }
