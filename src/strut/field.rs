@@ -365,11 +365,6 @@ mod tests {
         all
     }
 
-    /// The per-cell evaluation with augmentation equals the distance to every strut of a 5×5×5
-    /// lattice, brute force, at 10⁵ random points in its middle 3×3×3 cells, for every
-    /// built-in cell and a custom cell whose struts cross faces, edges and corners. The
-    /// comparison is clamped at the reach, which is below the distance from any point of the
-    /// middle cells to a strut of a cell outside the block.
     /// The value and gradient Newton uses equal the value and its central differences at random
     /// points of every built-in cell (capsules) and of a cell with rounded cones, away from the
     /// creases where two struts tie; at a point on a mirror plane of a node the gradient lies
@@ -429,6 +424,11 @@ mod tests {
         );
     }
 
+    /// The per-cell evaluation with augmentation equals the distance to every strut of a 5×5×5
+    /// lattice, brute force, at 10⁵ random points in its middle 3×3×3 cells, for every
+    /// built-in cell and a custom cell whose struts cross faces, edges and corners. The
+    /// comparison is clamped at the reach, which is below the distance from any point of the
+    /// middle cells to a strut of a cell outside the block.
     #[test]
     fn one_cell_with_augmentation_is_the_whole_lattice() {
         // Loose struts (not one lattice: a cell file would be refused), for the evaluation only.
