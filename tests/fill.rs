@@ -172,6 +172,72 @@ fn a_real_part_is_filled_and_sound() {
     );
 }
 
+/// `torus.stl` without a skin, cut from a sheet gyroid at 0.3 in 4 mm cells: an open-cell part
+/// whose surface cuts fragments loose.
+const OPEN_TORUS: [&str; 10] = [
+    "torus.stl",
+    "--no-skin",
+    "--lattice",
+    "gyroid",
+    "--structure",
+    "sheet",
+    "--cell-size",
+    "4",
+    "--density",
+    "0.3",
+];
+
+/// A part meshed in tiles finds its pieces across them: the fragments that a torus's surface
+/// cuts loose from an open-cell lattice are dropped from the tiles as from the whole part — the
+/// same triangles (as sorted records of the two files), the same fragments counted — at small
+/// tiles (many seams) and large ones, and what is written is one piece by this test's count.
+#[test]
+fn tiles_drop_the_fragments_the_whole_part_drops() {
+    let dir = tempdir();
+    let d = dir.path();
+    write_stl(&d.join("torus.stl"), &torus_tris(12.0, 4.0, 192, 96));
+    let mut common = OPEN_TORUS.to_vec();
+    common.extend(["--resolution", "12"]);
+    let records = |p: &Path| {
+        let mut r: Vec<[u64; 9]> = read_stl(p)
+            .iter()
+            .map(|t| {
+                let c = t.concat();
+                std::array::from_fn(|i| c[i].to_bits())
+            })
+            .collect();
+        r.sort_unstable();
+        r
+    };
+    let whole = filled(d, &common);
+    let whole_records = records(&d.join("part.stl"));
+    let fragments = &whole.report["fragments"];
+    assert!(
+        fragments["count"].as_u64().unwrap() > 0,
+        "the case must cut fragments loose: {fragments}"
+    );
+    for tile in ["16", "48"] {
+        let mut args = common.to_vec();
+        args.extend(["--tile", tile]);
+        let tiled = filled(d, &args);
+        let r = &tiled.report;
+        assert!(r["tiling"]["tiles"].as_u64().unwrap() > 4, "tile {tile}");
+        let g = &r["fragments"];
+        assert_eq!(g["count"], fragments["count"], "tile {tile}: fragments");
+        assert_eq!(g["removed"], true, "tile {tile}: fragments");
+        assert!(
+            (f(g, "volume") - f(fragments, "volume")).abs() <= 1e-9 * whole.volume,
+            "tile {tile}: fragments' volume {g} against {fragments}"
+        );
+        assert_eq!(r["one_piece"], true, "tile {tile}");
+        assert_eq!(r["vertices"], whole.report["vertices"], "tile {tile}");
+        assert!(
+            records(&d.join("part.stl")) == whole_records,
+            "tile {tile}: the tiled part's triangles differ from the whole part's"
+        );
+    }
+}
+
 /// Without a skin the part is the lattice cut by its surface (fragments it cuts loose
 /// removed); a kept solid stays whole inside a skinned part, and the density is the lattice's
 /// share of the rest of the core.
@@ -180,23 +246,9 @@ fn no_skin_and_kept_solids() {
     let dir = tempdir();
     let d = dir.path();
     write_stl(&d.join("torus.stl"), &torus_tris(15.0, 5.0, 256, 128));
-    let p = filled(
-        d,
-        &[
-            "torus.stl",
-            "--no-skin",
-            "--lattice",
-            "gyroid",
-            "--structure",
-            "sheet",
-            "--cell-size",
-            "4",
-            "--density",
-            "0.3",
-            "--resolution",
-            "16",
-        ],
-    );
+    let mut args = OPEN_TORUS.to_vec();
+    args.extend(["--resolution", "16"]);
+    let p = filled(d, &args);
     let whole = torus_volume(15.0, 5.0);
     assert_eq!(f(&p.report, "skin_volume"), 0.0);
     assert!(
@@ -320,7 +372,7 @@ fn bad_input_is_refused_in_one_line() {
 }
 
 /// For random lattices, skins, cell sizes, densities and boxes that are not whole cells, at
-/// odd origins: the part is sound and one piece, the fill's density within 0.002 of the target,
+/// odd origins, whole or in tiles of random size: the part is sound and one piece, the fill's density within 0.002 of the target,
 /// and the regions latvox measured agree with the box's (its skin: the box less the box shrunk
 /// by the skin on every side) — up to the rounding of the box's edges: the distance field is
 /// sampled on voxels, so each edge loses a sliver of about half a voxel squared per mm of edge
@@ -343,6 +395,9 @@ fn every_setting_gives_a_sound_part_at_its_density() {
         } else {
             rng.uniform(0.6, 1.5)
         };
+        // Every other part in tiles (found in pieces across them, fragments dropped).
+        let tile = ["16", "24", "32", "40"][rng.below(4) as usize];
+        let tiled = case % 2 == 1;
         let (cell_s, density_s, skin_s) = (
             format!("{cell:.3}"),
             format!("{density:.3}"),
@@ -364,7 +419,16 @@ fn every_setting_gives_a_sound_part_at_its_density() {
         } else {
             args.extend_from_slice(&["--skin", &skin_s]);
         }
+        if tiled {
+            args.extend_from_slice(&["--tile", tile]);
+        }
         let p = filled(d, &args);
+        // The target is what the command line said.
+        let density: f64 = density_s.parse().unwrap();
+        if tiled {
+            assert!(p.report["tiling"]["tiles"].as_u64().unwrap() > 1);
+            assert_eq!(p.report["one_piece"], true, "case {case}: {args:?}");
+        }
         let r = &p.report;
         let what = format!("case {case}: {args:?}");
         assert!(

@@ -214,7 +214,7 @@ pub(crate) fn print_part(r: &PartReport) {
     outln!(
         "pieces    {}",
         match r.one_piece {
-            None => "not checked (meshed in tiles without a template of its cells)".to_string(),
+            None => "not checked".to_string(),
             Some(true) if f.count == 0 => "one".to_string(),
             Some(true) => format!(
                 "one ({} fragment{plural} cut loose removed, {:.3} mm³)",

@@ -48,17 +48,30 @@ pub struct Shells {
 impl Shells {
     /// Finds the shells of `mesh` and which belong to its largest piece.
     pub fn of(mesh: &KeyedMesh) -> Shells {
+        Shells::of_quads(mesh, |_| true)
+    }
+
+    /// Finds the shells that the quads of `mesh` marked by `quad` form, and which belong to
+    /// their largest piece; a vertex on no such quad is in no shell (`u32::MAX`).
+    pub fn of_quads(mesh: &KeyedMesh, quad: impl Fn(usize) -> bool) -> Shells {
         let n = mesh.positions.len();
         let mut uf = UnionFind::new(n);
-        for q in &mesh.quads {
-            uf.union(q[0], q[1]);
-            uf.union(q[0], q[2]);
-            uf.union(q[0], q[3]);
+        let mut on = vec![false; n];
+        for (i, q) in mesh.quads.iter().enumerate() {
+            if quad(i) {
+                uf.union(q[0], q[1]);
+                uf.union(q[0], q[2]);
+                uf.union(q[0], q[3]);
+                q.iter().for_each(|&v| on[v as usize] = true);
+            }
         }
         let mut id = vec![u32::MAX; n];
         let mut count = 0u32;
         let of_vertex: Vec<u32> = (0..n as u32)
             .map(|v| {
+                if !on[v as usize] {
+                    return u32::MAX;
+                }
                 let r = uf.find(v) as usize;
                 if id[r] == u32::MAX {
                     id[r] = count;
@@ -73,31 +86,26 @@ impl Shells {
         };
         let mut volume = vec![0.0; count as usize];
         let mut bounds = vec![empty; count as usize];
-        for t in mesh.triangles() {
-            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
-            volume[of_vertex[t[0] as usize] as usize] += signed_volume(a, b, c);
+        for (i, q) in mesh.quads.iter().enumerate() {
+            if quad(i) {
+                let (t, u) = mesh.quad_triangles(i);
+                for t in std::iter::once(t).chain(u) {
+                    let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+                    volume[of_vertex[q[0] as usize] as usize] += signed_volume(a, b, c);
+                }
+            }
         }
         for (v, p) in mesh.positions.iter().enumerate() {
+            if of_vertex[v] == u32::MAX {
+                continue;
+            }
             let b = &mut bounds[of_vertex[v] as usize];
             for (a, &x) in p.iter().enumerate() {
                 b.min[a] = b.min[a].min(x);
                 b.max[a] = b.max[a].max(x);
             }
         }
-        let main = (0..count as usize).max_by(|&a, &b| volume[a].total_cmp(&volume[b]));
-        let inside = |inner: &Aabb, outer: &Aabb| {
-            (0..3).all(|a| inner.min[a] >= outer.min[a] && inner.max[a] <= outer.max[a])
-        };
-        // An outer shell other than the main one is a fragment; a cavity goes with the
-        // fragment whose bounds hold it, and otherwise with the part.
-        let kept: Vec<bool> = (0..count as usize)
-            .map(|s| match main {
-                Some(m) if s == m => true,
-                _ if volume[s] > 0.0 => false,
-                _ => !(0..count as usize)
-                    .any(|o| Some(o) != main && volume[o] > 0.0 && inside(&bounds[s], &bounds[o])),
-            })
-            .collect();
+        let kept = kept_shells(&volume, &bounds);
         Shells {
             of_vertex,
             volume,
@@ -108,18 +116,43 @@ impl Shells {
 
     /// The fragments: outer shells not kept, with the cavities they hold.
     pub fn fragments(&self, removed: bool) -> Fragments {
-        let mut f = Fragments {
-            removed,
-            ..Default::default()
-        };
-        for (s, &k) in self.kept.iter().enumerate() {
-            if !k {
-                f.count += (self.volume[s] > 0.0) as u64;
-                f.volume += self.volume[s];
-            }
-        }
-        f
+        fragments_of(&self.volume, &self.kept, removed)
     }
+}
+
+/// Which shells (by signed volume and bounds) belong to the largest piece: the outer shell of
+/// largest volume, and every cavity that no other outer shell's bounds hold.
+pub fn kept_shells(volume: &[f64], bounds: &[Aabb]) -> Vec<bool> {
+    let count = volume.len();
+    let main = (0..count).max_by(|&a, &b| volume[a].total_cmp(&volume[b]));
+    let inside = |inner: &Aabb, outer: &Aabb| {
+        (0..3).all(|a| inner.min[a] >= outer.min[a] && inner.max[a] <= outer.max[a])
+    };
+    // An outer shell other than the main one is a fragment; a cavity goes with the fragment
+    // whose bounds hold it, and otherwise with the part.
+    (0..count)
+        .map(|s| match main {
+            Some(m) if s == m => true,
+            _ if volume[s] > 0.0 => false,
+            _ => !(0..count)
+                .any(|o| Some(o) != main && volume[o] > 0.0 && inside(&bounds[s], &bounds[o])),
+        })
+        .collect()
+}
+
+/// The fragments among shells of signed `volume`, `kept` as [`kept_shells`] says.
+pub fn fragments_of(volume: &[f64], kept: &[bool], removed: bool) -> Fragments {
+    let mut f = Fragments {
+        removed,
+        ..Default::default()
+    };
+    for (s, &k) in kept.iter().enumerate() {
+        if !k {
+            f.count += (volume[s] > 0.0) as u64;
+            f.volume += volume[s];
+        }
+    }
+    f
 }
 
 /// Removes the fragments of `mesh` (every shell not in its largest piece), keeping the order of
@@ -133,7 +166,7 @@ pub fn remove_fragments(mesh: &mut KeyedMesh) -> Fragments {
     let keep_vertex: Vec<bool> = shells
         .of_vertex
         .iter()
-        .map(|&s| shells.kept[s as usize])
+        .map(|&s| s != u32::MAX && shells.kept[s as usize])
         .collect();
     retain(mesh, &keep_vertex);
     f

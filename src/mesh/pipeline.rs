@@ -272,6 +272,9 @@ pub enum Made {
     /// Nothing held: the part is meshed again, tile by tile, as it is written; the measuring
     /// template (if any) says which vertices belong to fragments.
     Tiles(Option<Template>),
+    /// Nothing held but the part's pieces, found across its tiles: it is meshed again, on the
+    /// same tiles, as it is written, and its fragments dropped.
+    TilePieces(tile::TiledPieces),
 }
 
 /// A part meshed (or measured) at one level.
@@ -322,10 +325,13 @@ pub fn measure<F: Family>(
             (Made::Whole(mesh), v, f, stats)
         }
         Route::Tiled(edge, None) => {
-            // No template: the part's volume is measured tile by tile, nothing written.
-            let (v, stats) = tiled_volume(&solid, voxel, edge)?;
-            let f = Fragments::default();
-            (Made::Tiles(None), v, f, stats)
+            // No template: the part's volume and pieces are found tile by tile, nothing written.
+            let (v, stats, found) = tiled_volume(&solid, voxel, edge, true)?;
+            let found = found.expect("pieces were asked for");
+            let mut f = found.fragments;
+            f.removed = !o.keep_fragments;
+            let v = if f.removed { v - f.volume } else { v };
+            (Made::TilePieces(found), v, f, stats)
         }
     };
     Ok(Measured {
@@ -341,7 +347,9 @@ pub fn measure<F: Family>(
 /// fragments included, mm³.
 pub fn solid_volume<S: Solid>(solid: &S, voxel: f64, route: Route) -> Result<(f64, MeshingStats)> {
     match route {
-        Route::Tiled(edge, _) => tiled_volume(solid, voxel, edge),
+        Route::Tiled(edge, _) => {
+            tiled_volume(solid, voxel, edge, false).map(|(v, stats, _)| (v, stats))
+        }
         _ => {
             let (mesh, stats) = mesh_keyed(solid, part_spec(solid, voxel), None, 0.0, None)?;
             Ok((keyed_volume(&mesh), stats))
@@ -359,8 +367,14 @@ pub fn keyed_volume(mesh: &KeyedMesh) -> f64 {
     })
 }
 
-/// The volume of the part meshed tile by tile, without writing it.
-fn tiled_volume<S: Solid>(solid: &S, voxel: f64, edge: i64) -> Result<(f64, MeshingStats)> {
+/// The volume of the part meshed tile by tile (fragments included) without writing it, and,
+/// when asked, its pieces.
+fn tiled_volume<S: Solid>(
+    solid: &S,
+    voxel: f64,
+    edge: i64,
+    find_pieces: bool,
+) -> Result<(f64, MeshingStats, Option<tile::TiledPieces>)> {
     let spec = part_spec(solid, voxel);
     let stats = std::sync::Mutex::new(MeshingStats::default());
     let mesh_tile = |r: IndexBox| {
@@ -377,12 +391,18 @@ fn tiled_volume<S: Solid>(solid: &S, voxel: f64, edge: i64) -> Result<(f64, Mesh
         edge,
         &mesh_tile,
         Verify::Fast,
+        if find_pieces {
+            tile::Pieces::Find
+        } else {
+            tile::Pieces::Keep
+        },
         &Progress::hidden(),
         &mut sink,
     )?;
     Ok((
         out.measures.volume,
         stats.into_inner().expect("no panic while holding the lock"),
+        out.pieces,
     ))
 }
 
@@ -594,6 +614,18 @@ pub fn write<F: Family>(
             voxel,
             edge,
             template.as_ref(),
+            None,
+            m.fragments,
+            o,
+            progress,
+            sink,
+        ),
+        (Route::Tiled(edge, _), Made::TilePieces(found)) => write_tiled(
+            &solid,
+            voxel,
+            edge,
+            None,
+            Some(&found),
             m.fragments,
             o,
             progress,
@@ -657,12 +689,17 @@ fn write_tiled<S: Solid>(
     voxel: f64,
     edge: i64,
     template: Option<&Template>,
+    found: Option<&tile::TiledPieces>,
     fragments: Fragments,
     o: &Options,
     progress: &Progress,
     sink: &mut dyn MeshSink,
 ) -> Result<Written> {
     let spec = part_spec(solid, voxel);
+    let pieces = match found {
+        Some(p) if !o.keep_fragments => tile::Pieces::Drop(p),
+        _ => tile::Pieces::Keep,
+    };
     let stats = std::sync::Mutex::new(MeshingStats::default());
     let mesh_tile = |r: IndexBox| {
         let (mut m, s) = mesh_keyed(solid, spec, Some(r), 0.0, None)?;
@@ -686,6 +723,7 @@ fn write_tiled<S: Solid>(
             edge,
             &mesh_tile,
             o.verify,
+            pieces,
             progress,
             sink,
         )?

@@ -95,8 +95,7 @@ pub struct PartReport {
     pub checks: Verification,
     /// Pieces of the lattice the box cut loose: removed (unless kept with `keep_fragments`).
     pub fragments: Fragments,
-    /// Whether what was written is one piece (`null` where it was not checked: a part meshed in
-    /// tiles without a template of its cells).
+    /// Whether what was written is one piece.
     pub one_piece: Option<bool>,
     /// Set when the part was copied from a template.
     pub instancing: Option<Instancing>,
@@ -133,10 +132,7 @@ impl PartReport {
         }
         let measures = written.measures;
         let achieved = measures.volume / bounds.volume();
-        let one_piece = match route {
-            Route::Tiled(_, None) => None,
-            _ => Some(written.fragments.count == 0 || written.fragments.removed),
-        };
+        let one_piece = Some(written.fragments.count == 0 || written.fragments.removed);
         let mut report = PartReport {
             target_density: target,
             achieved_density: achieved,

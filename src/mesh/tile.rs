@@ -12,13 +12,23 @@
 //!
 //! Each tile is checked as it is written, on the mesh around it (which the margin holds
 //! complete): every edge of a kept triangle must meet exactly one other triangle, running the other
-//! way, and CGAL's self-intersection test runs on the kept triangles with their neighbours.
+//! way, and the self-intersection search runs on the kept triangles with their neighbours.
+//!
+//! The part's pieces are found across the tiles ([`TiledPieces`]): each tile's kept triangles
+//! form shells (joined through shared vertices), and the shells of neighbouring tiles are joined
+//! through the vertices on their seams — a vertex is named by its key in every tile, so the
+//! same vertex met in two tiles is one. The pieces are found while the part is measured, and the
+//! fragments dropped when it is meshed again, on the same tiles, to be written (a fragment is a
+//! whole closed shell: what stays is as closed as before).
 
 use crate::check::verify::Verify;
 use crate::error::Result;
+use crate::field::Aabb;
 use crate::grid::IndexBox;
 use crate::io::sink::{Measures, MeshSink, Triangle};
-use crate::mesh::extract::KeyedMesh;
+use crate::mesh::extract::{KeyedMesh, VertexKey};
+use crate::mesh::pieces::{self, Fragments, Shells};
+use crate::mesh::topology::UnionFind;
 use crate::progress::Progress;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -57,8 +67,113 @@ pub fn tiles(region: IndexBox, edge: i64) -> Vec<IndexBox> {
     out
 }
 
+/// What a tiled meshing does with the part's pieces.
+#[derive(Clone, Copy)]
+pub enum Pieces<'a> {
+    /// Nothing: every triangle is written.
+    Keep,
+    /// Finds them (returned in [`TiledOutcome::pieces`]).
+    Find,
+    /// Drops the fragments that an earlier meshing of the same part, on the same tiles, found.
+    Drop(&'a TiledPieces),
+}
+
+/// The pieces of a part meshed in tiles: the tiles' shells joined across their seams, and which
+/// of them belong to the part (the largest piece, see [`crate::mesh::pieces`]).
+#[derive(Debug, Default)]
+pub struct TiledPieces {
+    /// Each tile's first shell (shells are numbered tile after tile).
+    first: Vec<u32>,
+    /// Per shell: its signed volume, mm³, and bounds, until the pieces are found.
+    volume: Vec<f64>,
+    bounds: Vec<Aabb>,
+    /// The shells joined so far.
+    joined: UnionFind,
+    /// Vertices on a seam: key → a shell it is on.
+    seams: HashMap<VertexKey, u32>,
+    /// Per shell: whether it belongs to the part (set by [`TiledPieces::finish`]).
+    kept: Vec<bool>,
+    /// The fragments (set by [`TiledPieces::finish`]).
+    pub fragments: Fragments,
+}
+
+/// Whether a vertex in voxel `v` may be on triangles of another tile than `own`: a quad is
+/// kept by the tile holding the start of its edge, and the quads around a vertex have their
+/// edges start in `[v, v + 1]³`.
+fn on_seam(v: [i32; 3], own: &IndexBox) -> bool {
+    (0..3).any(|a| (v[a] as i64) < own.lo[a] || v[a] as i64 + 1 >= own.hi[a])
+}
+
+impl TiledPieces {
+    /// Adds the next tile's shells and the keys of its vertices on a seam.
+    fn add(&mut self, shells: &Shells, seams: &[(VertexKey, u32)]) {
+        let first = self.volume.len() as u32;
+        self.first.push(first);
+        self.volume.extend_from_slice(&shells.volume);
+        self.bounds.extend_from_slice(&shells.bounds);
+        self.joined
+            .0
+            .extend(first..first + shells.volume.len() as u32);
+        for &(key, s) in seams {
+            let node = first + s;
+            match self.seams.entry(key) {
+                std::collections::hash_map::Entry::Occupied(e) => self.joined.union(*e.get(), node),
+                std::collections::hash_map::Entry::Vacant(e) => {
+                    e.insert(node);
+                }
+            }
+        }
+    }
+
+    /// Joins the shells into pieces and marks the part's.
+    fn finish(&mut self) {
+        let n = self.volume.len();
+        let mut id = vec![u32::MAX; n];
+        let mut piece_volume = Vec::new();
+        let mut piece_bounds: Vec<Aabb> = Vec::new();
+        let of: Vec<u32> = (0..n as u32)
+            .map(|s| {
+                let r = self.joined.find(s) as usize;
+                if id[r] == u32::MAX {
+                    id[r] = piece_volume.len() as u32;
+                    piece_volume.push(0.0);
+                    piece_bounds.push(Aabb {
+                        min: [f64::INFINITY; 3],
+                        max: [f64::NEG_INFINITY; 3],
+                    });
+                }
+                id[r]
+            })
+            .collect();
+        for (s, &p) in of.iter().enumerate() {
+            let p = p as usize;
+            piece_volume[p] += self.volume[s];
+            let (b, o) = (&mut piece_bounds[p], &self.bounds[s]);
+            for a in 0..3 {
+                b.min[a] = b.min[a].min(o.min[a]);
+                b.max[a] = b.max[a].max(o.max[a]);
+            }
+        }
+        let kept = pieces::kept_shells(&piece_volume, &piece_bounds);
+        self.fragments = pieces::fragments_of(&piece_volume, &kept, false);
+        self.kept = of.iter().map(|&p| kept[p as usize]).collect();
+        self.volume = Vec::new();
+        self.bounds = Vec::new();
+    }
+
+    /// Whether shell `s` of tile `tile` belongs to the part.
+    fn kept(&self, tile: usize, s: u32) -> bool {
+        self.kept[(self.first[tile] + s) as usize]
+    }
+
+    /// Whether the vertex with `key`, on a seam, belongs to the part.
+    fn seam_kept(&self, key: &VertexKey) -> Option<bool> {
+        self.seams.get(key).map(|&s| self.kept[s as usize])
+    }
+}
+
 /// What the tiled meshing wrote and found.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Default)]
 pub struct TiledOutcome {
     /// Measures of the triangles written.
     pub measures: Measures,
@@ -73,6 +188,8 @@ pub struct TiledOutcome {
     pub self_intersection_checked: bool,
     /// Whether CGAL found a kept triangle intersecting another.
     pub self_intersecting: bool,
+    /// The part's pieces, when asked to find them ([`Pieces::Find`]).
+    pub pieces: Option<TiledPieces>,
 }
 
 struct TileResult {
@@ -80,6 +197,8 @@ struct TileResult {
     vertices: u64,
     bad_edges: u64,
     self_intersecting: bool,
+    /// With [`Pieces::Find`]: the tile's shells and its seam vertices' keys with their shells.
+    shells: Option<(Shells, Vec<(VertexKey, u32)>)>,
 }
 
 /// Meshes `region` tile by tile with `mesh_tile` (which meshes the samples of the box it is
@@ -89,6 +208,7 @@ pub fn mesh_tiled(
     edge: i64,
     mesh_tile: &(dyn Fn(IndexBox) -> Result<KeyedMesh> + Sync),
     verify: Verify,
+    pieces: Pieces,
     progress: &Progress,
     sink: &mut dyn MeshSink,
 ) -> Result<TiledOutcome> {
@@ -99,17 +219,22 @@ pub fn mesh_tiled(
         self_intersection_checked: verify.self_intersection(),
         ..Default::default()
     };
+    let mut found = TiledPieces::default();
     let counter = progress.counter(all.len() as u64, "tiles meshed, verified and written");
-    for group in all.chunks(CONCURRENT_TILES) {
+    for (g, group) in all.chunks(CONCURRENT_TILES).enumerate() {
         let results: Vec<Result<TileResult>> = group
             .par_iter()
-            .map(|own| {
+            .enumerate()
+            .map(|(i, own)| {
                 let mesh = mesh_tile(own.grown(MARGIN))?;
-                tile_result(&mesh, own, verify)
+                tile_result(&mesh, own, verify, pieces, g * CONCURRENT_TILES + i)
             })
             .collect();
         for r in results {
             let r = r?;
+            if let Some((shells, seams)) = &r.shells {
+                found.add(shells, seams);
+            }
             out.measures = out.measures.merged(&Measures::of(&r.triangles));
             out.vertices += r.vertices;
             out.bad_edges += r.bad_edges;
@@ -119,15 +244,57 @@ pub fn mesh_tiled(
         }
     }
     sink.finish()?;
+    if matches!(pieces, Pieces::Find) {
+        found.finish();
+        out.pieces = Some(found);
+    }
     Ok(out)
 }
 
-fn tile_result(mesh: &KeyedMesh, own: &IndexBox, verify: Verify) -> Result<TileResult> {
+fn tile_result(
+    mesh: &KeyedMesh,
+    own: &IndexBox,
+    verify: Verify,
+    pieces: Pieces,
+    tile: usize,
+) -> Result<TileResult> {
     let inside = |e: [i32; 3], m: i64| own.grown(m).contains(e.map(|x| x as i64));
-    let kept: Vec<usize> = (0..mesh.quads.len())
-        .filter(|&q| inside(mesh.edges[q], 0))
-        .collect();
-    let vertices = mesh.keys.iter().filter(|k| inside(k.voxel, 0)).count() as u64;
+    let ours = |q: usize| inside(mesh.edges[q], 0);
+    let mut shells = None;
+    let (kept, vertices): (Vec<usize>, u64) = match pieces {
+        Pieces::Keep => (
+            (0..mesh.quads.len()).filter(|&q| ours(q)).collect(),
+            mesh.keys.iter().filter(|k| inside(k.voxel, 0)).count() as u64,
+        ),
+        Pieces::Find => {
+            let found = Shells::of_quads(mesh, ours);
+            let seams: Vec<(VertexKey, u32)> = (0..mesh.keys.len())
+                .filter(|&v| found.of_vertex[v] != u32::MAX && on_seam(mesh.keys[v].voxel, own))
+                .map(|v| (mesh.keys[v], found.of_vertex[v]))
+                .collect();
+            shells = Some((found, seams));
+            (
+                (0..mesh.quads.len()).filter(|&q| ours(q)).collect(),
+                mesh.keys.iter().filter(|k| inside(k.voxel, 0)).count() as u64,
+            )
+        }
+        Pieces::Drop(p) => {
+            let found = Shells::of_quads(mesh, ours);
+            let of = &found.of_vertex;
+            let kept = (0..mesh.quads.len())
+                .filter(|&q| ours(q) && p.kept(tile, of[mesh.quads[q][0] as usize]))
+                .collect();
+            // A vertex of this tile on none of its triangles is on a seam, on another tile's.
+            let vertices = (0..mesh.keys.len())
+                .filter(|&v| inside(mesh.keys[v].voxel, 0))
+                .filter(|&v| match of[v] {
+                    u32::MAX => p.seam_kept(&mesh.keys[v]).unwrap_or(true),
+                    s => p.kept(tile, s),
+                })
+                .count() as u64;
+            (kept, vertices)
+        }
+    };
     let f32pos = |v: u32| mesh.positions[v as usize].map(|x| x as f32);
     let mut triangles = Vec::with_capacity(2 * kept.len());
     for &q in &kept {
@@ -212,6 +379,7 @@ fn tile_result(mesh: &KeyedMesh, own: &IndexBox, verify: Verify) -> Result<TileR
         vertices,
         bad_edges,
         self_intersecting,
+        shells,
     })
 }
 

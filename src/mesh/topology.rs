@@ -22,6 +22,7 @@ pub struct Topology {
 }
 
 /// Disjoint sets with path halving and union by index (smaller root wins, so roots are stable).
+#[derive(Debug, Clone, Default)]
 pub struct UnionFind(pub Vec<u32>);
 
 impl UnionFind {
