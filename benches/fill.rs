@@ -57,7 +57,7 @@ fn main() {
     let tm = &p.timings;
     let cells = p.bounds.volume() / cell.powi(3);
     println!(
-        "torus {size} mm across ({cells:.0} cells of {cell} mm in its box), skin 1 mm, gyroid net 0.2, voxel {:.4} mm, memory budget {} MB: {} meshings, fill density {:.4}, {} triangles ({:.1} GB of STL, dropped), {}, valid {}: wall {:.1} s (sample {:.1}, mesh {:.1}, verify {:.1}, write {:.1}), distance grid {:.0} MB, peak RSS {:.0} MB",
+        "torus {size} mm across ({cells:.0} cells of {cell} mm in its box), skin 1 mm, gyroid net 0.2, voxel {:.4} mm, memory budget {} MB: {} meshings, fill density {:.4}, {} triangles ({:.1} GB of STL, dropped), {}, {} fragments removed, one piece {:?}, valid {}: wall {:.1} s (sample {:.1}, mesh {:.1}, verify {:.1}, write {:.1}), distance grid {:.0} MB, peak RSS {:.0} MB",
         r.voxel_size,
         memory >> 20,
         r.level_search.tried.len() + 2,
@@ -68,6 +68,8 @@ fn main() {
             Some(t) => format!("{} tiles of {} voxels", t.tiles, t.tile_samples),
             None => "whole".to_string(),
         },
+        p.fragments.count,
+        p.one_piece,
         r.verdict().is_valid_solid(),
         t.elapsed().as_secs_f64(),
         tm.sample,

@@ -131,6 +131,8 @@ impl FillReport {
 struct Found<F: Family> {
     voxel: f64,
     route: Route,
+    /// The pipeline's options, the budget less the distance grid.
+    options: Options,
     family: FillFamily<F>,
     best: Measured,
     tried: Vec<(f64, f64)>,
@@ -333,16 +335,25 @@ impl FillJob {
                 blend: self.blend,
                 infill,
             };
-            let route = Route::choose(&solid(Infill::Full), voxel, opts);
+            // The part's distance grid is held throughout: the meshing gets the rest of the budget.
+            let opts = &Options {
+                memory: Some(
+                    opts.memory
+                        .unwrap_or(pipeline::DEFAULT_MEMORY)
+                        .saturating_sub(shape.memory_bytes()),
+                ),
+                ..*opts
+            };
+            let part_route = Route::choose(&solid(Infill::Full), voxel, opts);
             let (whole, mut meshing) = {
                 let _p = progress.stage("measuring the part");
-                pipeline::solid_volume(&solid(Infill::Full), voxel, route)?
+                pipeline::solid_volume(&solid(Infill::Full), voxel, part_route)?
             };
             let base = if self.skin == 0.0 && keep.is_empty() {
                 0.0
             } else {
                 let _p = progress.stage("measuring the skin");
-                let (v, m) = pipeline::solid_volume(&solid(Infill::Empty), voxel, route)?;
+                let (v, m) = pipeline::solid_volume(&solid(Infill::Empty), voxel, part_route)?;
                 meshing.add(&m);
                 v
             };
@@ -359,6 +370,8 @@ impl FillJob {
                 base_volume: base,
                 fill_volume: fill,
             };
+            // Tiles are sized for the lattice's surface, not the bare part's.
+            let route = Route::choose(&family.at(start_level), voxel, opts);
             let solved = {
                 let _p = progress.stage(if r == self.resolution {
                     "finding the lattice's level"
@@ -374,6 +387,7 @@ impl FillJob {
             Ok(Ok(Found {
                 voxel,
                 route,
+                options: *opts,
                 grid_bytes: shape.memory_bytes(),
                 family,
                 best: solved.best,
@@ -384,6 +398,7 @@ impl FillJob {
         let Found {
             voxel,
             route,
+            options,
             family,
             best,
             tried,
@@ -392,7 +407,7 @@ impl FillJob {
         } = resolved.found;
         let level = best.level;
         let level_search = LevelSearch::new(&best, route, &tried, resolved.coarser);
-        let written = pipeline::write(&family, best, voxel, route, opts, progress, sink)?;
+        let written = pipeline::write(&family, best, voxel, route, &options, progress, sink)?;
         let bounds = family.part.shape.bounds;
         let mut report = PartReport::new(
             bounds,

@@ -240,9 +240,27 @@ impl Route {
             }
         }
         let budget = o.memory.unwrap_or(DEFAULT_MEMORY);
+        // Memory grows with the triangles as much as with the voxels: the surface's density
+        // is probed on the part's grid before anything is meshed, unless the part would fit
+        // at any density.
+        let probed = std::cell::OnceCell::new();
+        let density = || {
+            *probed.get_or_init(|| {
+                let spec = part_spec(solid, voxel);
+                let field = solid.field(&spec);
+                let clipped = Intersection {
+                    a: &*field,
+                    b: bounds,
+                };
+                tile::triangle_density(&clipped, &spec)
+            })
+        };
         let fits = |b: &Aabb| {
-            let spec = GridSpec::covering(b, voxel, HALF_WIDTH);
-            spec.padded_region().voxels() * tile::BYTES_PER_VOXEL <= budget
+            let voxels = GridSpec::covering(b, voxel, HALF_WIDTH)
+                .padded_region()
+                .voxels();
+            let within = |d: f64| tile::meshing_bytes(voxels, d) + tile::RESERVED_BYTES <= budget;
+            within(tile::MAX_TRIANGLE_DENSITY) || within(density())
         };
         // A measuring template is worth meshing when it is small beside the part (each level
         // tried meshes it, and the part is meshed once more at the level found) and when it
@@ -257,7 +275,9 @@ impl Route {
         });
         match o.tile {
             Some(edge) => Route::Tiled(edge, measuring),
-            None if !fits(&bounds) => Route::Tiled(tile::tile_edge_for_budget(budget), measuring),
+            None if !fits(&bounds) => {
+                Route::Tiled(tile::tile_edge_for_budget(budget, density()), measuring)
+            }
             None => Route::Whole(measuring),
         }
     }

@@ -39,16 +39,76 @@ pub const MARGIN: i64 = 8;
 /// Tiles meshed at once (each also uses every core inside).
 pub const CONCURRENT_TILES: usize = 2;
 
-/// Memory used per voxel of a tile while it is meshed (grid, OpenVDB's meshing, the mesh):
-/// measured on dense lattices, about 20 bytes; taken as 32.
-pub const BYTES_PER_VOXEL: u64 = 32;
+/// Memory a tile takes while it is meshed, checked and written: per voxel of the tile and its
+/// margin (the sampled grid, OpenVDB's masks) and per triangle (the keyed mesh, the triangles
+/// written, the edge and self-intersection checks). Measured (heap profile and peak resident
+/// memory of gyroid parts at 12 to 48 voxels per cell, one tile of 240 voxels beside a thin
+/// one) at about 8 bytes a voxel and 175 a triangle; taken with a margin.
+pub const BYTES_PER_VOXEL: f64 = 10.0;
+/// See [`BYTES_PER_VOXEL`].
+pub const BYTES_PER_TRIANGLE: f64 = 190.0;
+/// Memory the process holds beside the part's meshing (code, libraries, thread stacks).
+pub const RESERVED_BYTES: u64 = 64 << 20;
+
+/// The most triangles a voxel can hold: each of its three edges crossed, two triangles each.
+pub const MAX_TRIANGLE_DENSITY: f64 = 6.0;
+
+/// Memory to mesh, check and write `voxels` voxels holding `density` triangles a voxel.
+pub fn meshing_bytes(voxels: u64, density: f64) -> u64 {
+    (voxels as f64 * (BYTES_PER_VOXEL + BYTES_PER_TRIANGLE * density)) as u64
+}
 
 /// The tile edge (samples, a multiple of 8) that keeps [`CONCURRENT_TILES`] tiles with their
-/// margins within `budget` bytes.
-pub fn tile_edge_for_budget(budget: u64) -> i64 {
-    let per_tile = budget as f64 / (CONCURRENT_TILES as u64 * BYTES_PER_VOXEL) as f64;
+/// margins, at `density` triangles a voxel, within `budget` bytes.
+pub fn tile_edge_for_budget(budget: u64, density: f64) -> i64 {
+    let per_tile = budget.saturating_sub(RESERVED_BYTES) as f64
+        / CONCURRENT_TILES as f64
+        / (BYTES_PER_VOXEL + BYTES_PER_TRIANGLE * density);
     let with_margin = per_tile.cbrt() as i64;
     ((with_margin - 2 * MARGIN) / 8 * 8).max(16)
+}
+
+/// Triangles a voxel where the part's surface is densest, estimated before meshing: the solid's
+/// field is sampled on 27 probes of 24³ samples spread over `region` (3 × 3 × 3, each at the
+/// middle of its part), and the edges between samples of opposite sign — each crossed by one
+/// quad of the mesh, two triangles — counted; the densest probe's count a voxel is returned.
+pub fn triangle_density(field: &dyn crate::field::Field, spec: &crate::grid::GridSpec) -> f64 {
+    const N: i64 = 24;
+    let region = spec.padded_region();
+    let probes: Vec<[i64; 3]> = (0..27)
+        .map(|i| {
+            let c = [i % 3, i / 3 % 3, i / 9];
+            [0, 1, 2].map(|a| {
+                let (lo, hi) = (region.lo[a], region.hi[a]);
+                let mid = lo + (hi - lo) * (2 * c[a] + 1) / 6;
+                (mid - N / 2).clamp(lo, (hi - N).max(lo))
+            })
+        })
+        .collect();
+    probes
+        .par_iter()
+        .map(|lo| {
+            let inside: Vec<bool> = (0..N * N * N)
+                .map(|i| {
+                    let idx = [lo[0] + i % N, lo[1] + i / N % N, lo[2] + i / (N * N)];
+                    field.value(spec.point(idx)) < 0.0
+                })
+                .collect();
+            let at = |x: i64, y: i64, z: i64| inside[(x + N * (y + N * z)) as usize];
+            let mut crossings = 0u64;
+            for z in 0..N {
+                for y in 0..N {
+                    for x in 0..N {
+                        let v = at(x, y, z);
+                        crossings += (x + 1 < N && v != at(x + 1, y, z)) as u64
+                            + (y + 1 < N && v != at(x, y + 1, z)) as u64
+                            + (z + 1 < N && v != at(x, y, z + 1)) as u64;
+                    }
+                }
+            }
+            2.0 * crossings as f64 / ((N - 1) * (N - 1) * (N - 1)) as f64
+        })
+        .reduce(|| 0.0, f64::max)
 }
 
 /// Cuts `region` (whole blocks) into tiles of `edge` samples (a multiple of 8), in x-major order.
@@ -242,6 +302,7 @@ pub fn mesh_tiled(
             sink.triangles(&r.triangles)?;
             counter.inc();
         }
+        release_freed_memory();
     }
     sink.finish()?;
     if matches!(pieces, Pieces::Find) {
@@ -249,6 +310,22 @@ pub fn mesh_tiled(
         out.pieces = Some(found);
     }
     Ok(out)
+}
+
+/// Hands the memory freed by the tiles just meshed back to the system. glibc's allocator keeps
+/// freed blocks under its mmap threshold (which rises to 32 MB as large blocks are freed) in its
+/// per-thread arenas; over a tiled part that kept a gigabyte more than the tiles held at once.
+fn release_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        extern "C" {
+            fn malloc_trim(pad: usize) -> i32;
+        }
+        // SAFETY: malloc_trim only returns free pages of glibc's own arenas to the system.
+        unsafe {
+            malloc_trim(0);
+        }
+    }
 }
 
 fn tile_result(
@@ -306,59 +383,78 @@ fn tile_result(
     }
 
     // Edges: the quads within two samples of the tile hold every triangle that shares an edge
-    // with a kept one.
-    let near: Vec<usize> = (0..mesh.quads.len())
-        .filter(|&q| inside(mesh.edges[q], 2))
-        .collect();
-    let mut directed: HashMap<(u32, u32), u32> = HashMap::with_capacity(6 * near.len());
+    // with a kept one. Their directed edges are listed by first vertex (counted, then placed:
+    // 4 bytes an edge, where a map would take several times that).
     let tris_of = |q: usize| {
         let (t, u) = mesh.quad_triangles(q);
         std::iter::once(t).chain(u)
     };
-    for &q in &near {
+    let near = || (0..mesh.quads.len()).filter(|&q| inside(mesh.edges[q], 2));
+    let n = mesh.positions.len();
+    let mut start = vec![0u32; n + 1];
+    for q in near() {
+        for t in tris_of(q) {
+            t.iter().for_each(|&v| start[v as usize + 1] += 1);
+        }
+    }
+    for v in 0..n {
+        start[v + 1] += start[v];
+    }
+    let mut to = vec![0u32; start[n] as usize];
+    let mut next = start.clone();
+    for q in near() {
         for t in tris_of(q) {
             for k in 0..3 {
-                *directed.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
+                let a = t[k] as usize;
+                to[next[a] as usize] = t[(k + 1) % 3];
+                next[a] += 1;
             }
         }
     }
+    drop(next);
+    let count = |a: u32, b: u32| {
+        to[start[a as usize] as usize..start[a as usize + 1] as usize]
+            .iter()
+            .filter(|&&x| x == b)
+            .count()
+    };
     let mut bad_edges = 0;
     for &q in &kept {
         for t in tris_of(q) {
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
-                let fwd = directed.get(&(a, b)).copied().unwrap_or(0);
-                let back = directed.get(&(b, a)).copied().unwrap_or(0);
-                if fwd != 1 || back != 1 {
+                if count(a, b) != 1 || count(b, a) != 1 {
                     bad_edges += 1;
                 }
             }
         }
     }
+    drop((start, to));
 
     // Self-intersection: kept triangles (first) and every triangle close enough to touch one;
     // only pairs with a kept triangle count (the patch's own rim may be non-manifold).
     let self_intersecting = if verify.self_intersection() && !kept.is_empty() {
         let around = (0..mesh.quads.len())
             .filter(|&q| !inside(mesh.edges[q], 0) && inside(mesh.edges[q], 3));
-        let mut index = HashMap::new();
+        let mut index = vec![u32::MAX; n];
         let mut patch = crate::mesh::Mesh::default();
         let mut kept_triangles = 0;
-        for (n, q) in kept.iter().copied().chain(around).enumerate() {
+        for (i, q) in kept.iter().copied().chain(around).enumerate() {
             for t in tris_of(q) {
-                if n < kept.len() {
+                if i < kept.len() {
                     kept_triangles += 1;
                 }
                 for v in t {
-                    let next = index.len() as u32;
-                    let id = *index.entry(v).or_insert(next);
-                    if id == next {
+                    let id = &mut index[v as usize];
+                    if *id == u32::MAX {
+                        *id = (patch.positions.len() / 3) as u32;
                         patch.positions.extend_from_slice(&f32pos(v));
                     }
-                    patch.indices.push(id);
+                    patch.indices.push(*id);
                 }
             }
         }
+        drop(index);
         let all: Vec<u32> = (0..patch.triangle_count() as u32).collect();
         let (_, pairs) = if verify == Verify::Cgal {
             crate::check::self_intersect::cgal_soup_self_intersections(
@@ -398,7 +494,8 @@ mod tests {
         let total: u64 = t.iter().map(|b| b.voxels()).sum();
         assert_eq!(total, region.voxels());
         assert_eq!(t.last().unwrap().hi, [40, 24, 16]);
-        assert!(tile_edge_for_budget(2 << 30) >= 128);
-        assert_eq!(tile_edge_for_budget(1), 16);
+        assert!(tile_edge_for_budget(2 << 30, 0.2) >= 128);
+        assert!(tile_edge_for_budget(2 << 30, 1.0) < tile_edge_for_budget(2 << 30, 0.2));
+        assert_eq!(tile_edge_for_budget(1, 0.2), 16);
     }
 }
