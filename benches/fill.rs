@@ -42,6 +42,7 @@ fn main() {
         cell: [cell; 3],
         density: 0.2,
         blend: 0.0,
+        drain: None,
         resolution,
         auto_resolution: false,
         options: Options {

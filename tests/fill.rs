@@ -172,6 +172,55 @@ fn a_real_part_is_filled_and_sound() {
     );
 }
 
+/// A skin closes the lattice's void: the part encloses it (reported, with a warning, and found
+/// here as a shell of negative volume in the file). Drain holes (`--drain 2`) open it — no
+/// enclosed void left in the file — and keep the part sound, one piece, at its density; the
+/// holes' axes cross the skin at the lowest and highest facets.
+#[test]
+fn drain_holes_open_the_void_a_skin_encloses() {
+    let dir = tempdir();
+    let d = dir.path();
+    write_stl(&d.join("box.stl"), &box_tris([0.0; 3], [20.0; 3]));
+    let voids = |d: &Path| {
+        shell_volumes(&read_stl(&d.join("part.stl")))
+            .iter()
+            .filter(|&&v| v < 0.0)
+            .count()
+    };
+    let args = ["box.stl", "--cell-size", "5", "--resolution", "12"];
+    let closed = filled(d, &args);
+    assert_eq!(voids(d), 1, "a skinned part encloses the lattice's void");
+    assert_eq!(closed.report["fragments"]["cavities"], 1);
+    let warned = closed.report["warnings"].as_array().unwrap();
+    assert!(
+        warned
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("--drain")),
+        "{warned:?}"
+    );
+    let mut drained_args = args.to_vec();
+    drained_args.extend(["--drain", "2"]);
+    let drained = filled(d, &drained_args);
+    assert_eq!(voids(d), 0, "the drain holes leave an enclosed void");
+    let r = &drained.report;
+    assert_eq!(r["fragments"]["cavities"], 0);
+    assert!((f(r, "achieved_density") - 0.2).abs() <= 0.002);
+    let holes = r["drains"].as_array().unwrap();
+    assert_eq!(holes.len(), 2);
+    for (h, z) in holes.iter().zip([0.0, 20.0]) {
+        assert!((h["from"][2].as_f64().unwrap() - z).abs() < 1e-9, "{h}");
+        assert_eq!(h["radius"], 1.0);
+    }
+    // Less material than the closed part by about the two holes through the skin.
+    let hole = PI * 1.0 * 1.0 * 1.0;
+    assert!(
+        closed.volume - drained.volume > hole,
+        "{} against {}",
+        drained.volume,
+        closed.volume
+    );
+}
+
 /// `torus.stl` without a skin, cut from a sheet gyroid at 0.3 in 4 mm cells: an open-cell part
 /// whose surface cuts fragments loose.
 const OPEN_TORUS: [&str; 10] = [
@@ -365,6 +414,9 @@ fn bad_input_is_refused_in_one_line() {
         (&["box.stl", "--density", "1.2"], "density"),
         (&["box.stl", "--skin", "-1"], "skin"),
         (&["box.stl", "--skin", "1", "--no-skin"], "--no-skin"),
+        (&["box.stl", "--no-skin", "--drain", "2"], "--no-skin"),
+        (&["box.stl", "--drain", "0"], "drain"),
+        (&["box.stl", "--drain", "11"], "too wide"),
     ];
     for (args, what) in cases {
         assert_refused(d, args, what);

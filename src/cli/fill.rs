@@ -4,7 +4,7 @@
 use super::lattice::{human, print_part, triple, MeshArgs, PartArgs};
 use super::out::outln;
 use super::tpms::parse_structure;
-use super::{parse_density, parse_length0, parse_positive3};
+use super::{parse_density, parse_length0, parse_positive, parse_positive3};
 use clap::Args;
 use latvox::fill::{FillJob, FillReport, Infilling};
 use latvox::io::ReadOptions;
@@ -27,6 +27,9 @@ Examples:
   # Save the settings (the part's file by its absolute path), then fill it again finer
   latvox fill bracket.stl --skin 1 --cell-size 4 -o filled.stl --save-part bracket.toml
   latvox fill --part bracket.toml --resolution 48 -o filled-fine.stl
+
+  # Two 3 mm escape holes through the skin (lowest and highest point) so powder can get out
+  latvox fill bracket.stl --skin 1 --cell-size 4 --drain 3 -o drained.stl
 
   # No skin: the part cut from a sheet gyroid, an open-cell part
   latvox fill implant.stl --no-skin --lattice gyroid --structure sheet --cell-size 3 \\
@@ -73,6 +76,10 @@ pub struct FillArgs {
     /// many mm (0: a sharp union).
     #[arg(long, value_name = "MM", default_value_t = 0.0, value_parser = parse_length0, allow_hyphen_values = true)]
     pub blend: f64,
+    /// Drain holes of this diameter, mm, through the skin at the part's lowest and highest facet
+    /// (along z), so that powder or resin can leave the lattice's void, which a skin closes.
+    #[arg(long, value_name = "MM", value_parser = parse_positive, conflicts_with = "no_skin", allow_hyphen_values = true)]
+    pub drain: Option<f64>,
     /// A solid kept whole (a boss, a flange), unioned with the filled part; repeat for more.
     #[arg(long, value_name = "SOLID")]
     pub keep: Vec<PathBuf>,
@@ -141,6 +148,7 @@ impl FillArgs {
             cell: self.cell_size,
             density: self.density,
             blend: self.blend,
+            drain: self.drain,
             resolution: self.mesh.resolution,
             auto_resolution: !self.mesh.fixed_resolution,
             options: self.mesh.options(),
@@ -198,6 +206,19 @@ fn print_summary(r: &FillReport) {
         human(r.skin, 4),
         r.fill_volume
     );
+    if !r.drains.is_empty() {
+        let at: Vec<String> = r
+            .drains
+            .iter()
+            .map(|d| format!("({})", d.from.map(|x| human(x, 3)).join(", ")))
+            .collect();
+        outln!(
+            "drains    {} holes of {} mm through the skin at {} mm",
+            r.drains.len(),
+            human(2.0 * r.drains[0].radius, 4),
+            at.join(" and ")
+        );
+    }
     let p = &r.part;
     outln!(
         "density   of the fill: target {:.4}  achieved {:.4}  (error {:+.5}) · level {:.5}",

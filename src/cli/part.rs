@@ -28,6 +28,7 @@ const PART_KEYS: &[(&str, &[&str])] = &[
             "cell-size",
             "density",
             "blend",
+            "drain",
             "keep",
         ],
     ),

@@ -6,7 +6,7 @@
 //! write and report. The meshing is [`crate::mesh::pipeline`]'s, the resolution search
 //! [`crate::mesh::resolution`]'s.
 
-use super::shape::{FillFamily, FillSolid, Infill, Shape};
+use super::shape::{Drain, FillFamily, FillSolid, Infill, Shape};
 use crate::check::Verdict;
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Vec3};
@@ -67,6 +67,8 @@ pub struct FillJob {
     /// Radius of the smooth minimum joining the lattice to the skin (and struts at their
     /// joints), mm.
     pub blend: f64,
+    /// Diameter of the drain holes through the skin, mm (none when not given).
+    pub drain: Option<f64>,
     /// Voxels per cell along the cell's shortest axis.
     pub resolution: u32,
     /// Raise the resolution when the lattice or the skin would be too thin for the voxels.
@@ -96,6 +98,8 @@ pub struct FillReport {
     pub level: f64,
     /// Radius of the smooth minimum at the lattice's joins, mm.
     pub blend: f64,
+    /// Drain holes through the skin (empty when none were asked for).
+    pub drains: Vec<Drain>,
     /// Volume of the whole part (and kept solids) meshed solid, mm³.
     pub part_volume: f64,
     /// Volume of the skin and kept solids alone, mm³.
@@ -326,7 +330,22 @@ impl FillJob {
             let voxel = self.min_cell() / r as f64;
             let shape = {
                 let _p = progress.stage("building the part's distance field");
-                Arc::new(Shape::new(part, keep, voxel, self.skin + self.blend)?)
+                let mut shape = Shape::new(part, keep, voxel, self.skin + self.blend)?;
+                if let (Some(d), true) = (self.drain, self.skin > 0.0) {
+                    let b = part.bounds().expect("a part has triangles");
+                    let least = (0..3)
+                        .map(|a| b.max[a] - b.min[a])
+                        .fold(f64::INFINITY, f64::min);
+                    if d > 0.5 * least {
+                        return Err(Error::invalid(format!(
+                            "a drain hole of {d} mm is too wide for {}: at most half its smallest extent, {} mm",
+                            self.part_name,
+                            0.5 * least
+                        )));
+                    }
+                    shape.drains = Drain::at_ends(part, d, self.skin + self.blend + voxel);
+                }
+                Arc::new(shape)
             };
             let lattice = make(shape.bounds);
             let solid = |infill| FillSolid {
@@ -439,6 +458,7 @@ impl FillJob {
             cell_size: self.cell,
             level,
             blend: self.blend,
+            drains: family.part.shape.drains.clone(),
             part_volume: family.base_volume + family.fill_volume,
             skin_volume: family.base_volume,
             fill_volume: family.fill_volume,

@@ -14,6 +14,13 @@
 //! skin. The same field with no lattice (`S = −P − T`) is the skin alone, and with the part
 //! full (`F = min(P, K)`) the whole part: their volumes give the region the lattice fills, so
 //! the lattice's density is measured on it.
+//!
+//! A skin closes the lattice's void inside the part: powder or resin left in it cannot get out.
+//! Drain holes (`--drain D`) are cylinders of diameter `D` through the skin, cut from every one
+//! of these fields alike (`max(F, −H)`, `H` the distance to the holes), so that the regions and
+//! the density are measured on the part as drilled: one at the part's lowest facet and one at
+//! its highest (along z, the usual build direction), each along the facet's inward normal, as
+//! deep as the skin and the blend and half a hole more.
 
 use crate::error::Result;
 use crate::field::{smooth_min, Aabb, Field, Vec3};
@@ -52,6 +59,69 @@ pub struct Shape {
     pub bounds: Aabb,
     /// Voxel edge, mm.
     pub voxel: f64,
+    /// Drain holes: axis from the part's surface inward, and radius, mm.
+    pub drains: Vec<Drain>,
+}
+
+/// A drain hole: a capsule around the segment `from`–`to` of radius `radius`, mm.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Drain {
+    /// Where the hole's axis meets the part's surface.
+    pub from: Vec3,
+    /// The end of the axis inside the part.
+    pub to: Vec3,
+    /// The hole's radius.
+    pub radius: f64,
+}
+
+impl Drain {
+    /// Signed distance to the hole (negative inside).
+    fn distance(&self, p: Vec3) -> f64 {
+        use crate::mesh::{dot, sub};
+        let (ab, ap) = (sub(self.to, self.from), sub(p, self.from));
+        let t = (dot(ap, ab) / dot(ab, ab)).clamp(0.0, 1.0);
+        let q = [0, 1, 2].map(|a| ap[a] - t * ab[a]);
+        dot(q, q).sqrt() - self.radius
+    }
+
+    /// Holes of `diameter` through a skin `depth` deep: at the lowest and the highest facet of
+    /// `part` along z, along their inward normals.
+    pub fn at_ends(part: &Mesh, diameter: f64, depth: f64) -> Vec<Drain> {
+        use crate::mesh::{cross, norm, sub};
+        let tris: Vec<[Vec3; 3]> = (0..part.triangle_count())
+            .map(|t| {
+                [0, 1, 2].map(|k| {
+                    let v = part.indices[3 * t + k] as usize;
+                    [0, 1, 2].map(|a| part.positions[3 * v + a] as f64)
+                })
+            })
+            .collect();
+        let lowest = tris.iter().min_by(|a, b| {
+            let top = |t: &[Vec3; 3]| t.iter().map(|v| v[2]).fold(f64::NEG_INFINITY, f64::max);
+            top(a).total_cmp(&top(b))
+        });
+        let highest = tris.iter().max_by(|a, b| {
+            let bottom = |t: &[Vec3; 3]| t.iter().map(|v| v[2]).fold(f64::INFINITY, f64::min);
+            bottom(a).total_cmp(&bottom(b))
+        });
+        [lowest, highest]
+            .into_iter()
+            .flatten()
+            .filter_map(|t| {
+                let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+                let l = norm(n);
+                (l > 0.0).then(|| {
+                    let from = [0, 1, 2].map(|a| (t[0][a] + t[1][a] + t[2][a]) / 3.0);
+                    let reach = depth + 0.5 * diameter;
+                    Drain {
+                        from,
+                        to: [0, 1, 2].map(|a| from[a] - reach * n[a] / l),
+                        radius: 0.5 * diameter,
+                    }
+                })
+            })
+            .collect()
+    }
 }
 
 impl Shape {
@@ -76,7 +146,16 @@ impl Shape {
             keep: grids,
             bounds: bounds.grown(2.0 * voxel),
             voxel,
+            drains: Vec::new(),
         })
+    }
+
+    /// The distance to the drain holes (negative inside one; infinite without holes).
+    fn drilled(&self, p: Vec3) -> f64 {
+        self.drains
+            .iter()
+            .map(|d| d.distance(p))
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Memory of the distance grids, bytes (OpenVDB's count).
@@ -193,9 +272,46 @@ impl<S: Solid> Field for FillField<'_, S> {
         let p = self.solid.shape.part.value_at(x);
         let l = self.lattice.as_ref().map_or(f64::INFINITY, |f| f.value(x));
         self.combine(p, l, self.kept(x))
+            .max(-self.solid.shape.drilled(x))
     }
 
     fn clearance(&self, x: Vec3) -> f64 {
+        let c = self.undrilled_clearance(x);
+        if self.solid.shape.drains.is_empty() {
+            return c;
+        }
+        let v = self.undrilled_value(x);
+        let d = self.solid.shape.drilled(x);
+        intersection_clearance(v, c, -d, d.abs())
+    }
+
+    fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
+        self.undrilled_block(origin, h, out);
+        if self.solid.shape.drains.is_empty() {
+            return;
+        }
+        for i in 0..8 {
+            for j in 0..8 {
+                for k in 0..8 {
+                    let p = [i, j, k].map(|a| a as f64 * h);
+                    let x = [origin[0] + p[0], origin[1] + p[1], origin[2] + p[2]];
+                    let o = &mut out[(i * 8 + j) * 8 + k];
+                    *o = o.max(-self.solid.shape.drilled(x) as f32);
+                }
+            }
+        }
+    }
+}
+
+impl<S: Solid> FillField<'_, S> {
+    /// The part's value before the drain holes.
+    fn undrilled_value(&self, x: Vec3) -> f64 {
+        let p = self.solid.shape.part.value_at(x);
+        let l = self.lattice.as_ref().map_or(f64::INFINITY, |f| f.value(x));
+        self.combine(p, l, self.kept(x))
+    }
+
+    fn undrilled_clearance(&self, x: Vec3) -> f64 {
         let s = self.solid;
         let p = s.shape.part.value_at(x);
         let h = s.shape.voxel;
@@ -237,7 +353,7 @@ impl<S: Solid> Field for FillField<'_, S> {
         union_clearance(v, inner, k, grid_clearance(k, h))
     }
 
-    fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
+    fn undrilled_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
         let mut points = [0.0f64; 3 * 512];
         for i in 0..8 {
             for j in 0..8 {

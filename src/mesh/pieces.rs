@@ -22,6 +22,11 @@ pub struct Fragments {
     pub volume: f64,
     /// Whether they were removed from what was written.
     pub removed: bool,
+    /// Voids the part encloses (cavities of the piece kept): powder or resin left in them
+    /// cannot get out.
+    pub cavities: u64,
+    /// Their volume, mm³ (positive).
+    pub cavity_volume: f64,
 }
 
 impl Fragments {
@@ -30,6 +35,8 @@ impl Fragments {
         self.count += o.count;
         self.volume += o.volume;
         self.removed |= o.removed;
+        self.cavities += o.cavities;
+        self.cavity_volume += o.cavity_volume;
     }
 }
 
@@ -150,6 +157,9 @@ pub fn fragments_of(volume: &[f64], kept: &[bool], removed: bool) -> Fragments {
         if !k {
             f.count += (volume[s] > 0.0) as u64;
             f.volume += volume[s];
+        } else if volume[s] < 0.0 {
+            f.cavities += 1;
+            f.cavity_volume -= volume[s];
         }
     }
     f

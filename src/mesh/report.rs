@@ -205,6 +205,17 @@ impl PartReport {
                 }
             ));
         }
+        let voids = match fragments.cavities {
+            0 => None,
+            1 => Some("1 void".to_string()),
+            n => Some(format!("{n} voids")),
+        };
+        if let Some(voids) = voids {
+            warnings.push(format!(
+                "the part encloses {voids} ({:.3} mm³) that powder or resin cannot leave (`latvox fill --drain MM` opens escape holes through a skin)",
+                fragments.cavity_volume,
+            ));
+        }
         warnings
     }
 

@@ -105,6 +105,13 @@ pub fn volume(tris: &[Tri]) -> f64 {
 /// Shells with positive volume (outer surfaces of separate pieces), found by joining triangles
 /// that share a corner.
 pub fn pieces(tris: &[Tri]) -> usize {
+    shell_volumes(tris).iter().filter(|&&v| v > 0.0).count()
+}
+
+/// Signed volume of each shell (triangles joined through shared corners): positive for the
+/// outside of a piece, negative for a void it encloses.
+#[allow(dead_code)]
+pub fn shell_volumes(tris: &[Tri]) -> Vec<f64> {
     let key = |p: [f64; 3]| p.map(|x| (x as f32).to_bits());
     let mut id: HashMap<[u32; 3], usize> = HashMap::new();
     let corners: Vec<[usize; 3]> = tris
@@ -135,7 +142,7 @@ pub fn pieces(tris: &[Tri]) -> usize {
         let r = find(&mut parent, c[0]);
         *shell_volume.entry(r).or_default() += volume(std::slice::from_ref(t));
     }
-    shell_volume.values().filter(|&&v| v > 0.0).count()
+    shell_volume.into_values().collect()
 }
 
 pub fn bounds(tris: &[Tri]) -> ([f64; 3], [f64; 3]) {
