@@ -20,7 +20,7 @@
 //! of these fields alike (`max(F, −H)`, `H` the distance to the holes), so that the regions and
 //! the density are measured on the part as drilled: one at the part's lowest facet and one at
 //! its highest (along z, the usual build direction), each along the facet's inward normal, as
-//! deep as the skin and the blend and half a hole more.
+//! deep as the skin, the blend, a voxel and half a hole.
 
 use crate::error::Result;
 use crate::field::{smooth_min, Aabb, Field, Vec3};
@@ -84,8 +84,8 @@ impl Drain {
         dot(q, q).sqrt() - self.radius
     }
 
-    /// Holes of `diameter` through a skin `depth` deep: at the lowest and the highest facet of
-    /// `part` along z, along their inward normals.
+    /// Holes of `diameter` reaching `depth` and half a hole into `part`: at its lowest and
+    /// highest facet along z, along their inward normals.
     pub fn at_ends(part: &Mesh, diameter: f64, depth: f64) -> Vec<Drain> {
         use crate::mesh::{cross, norm, sub};
         let tris: Vec<[Vec3; 3]> = (0..part.triangle_count())
@@ -269,10 +269,7 @@ impl<S: Solid> FillField<'_, S> {
 
 impl<S: Solid> Field for FillField<'_, S> {
     fn value(&self, x: Vec3) -> f64 {
-        let p = self.solid.shape.part.value_at(x);
-        let l = self.lattice.as_ref().map_or(f64::INFINITY, |f| f.value(x));
-        self.combine(p, l, self.kept(x))
-            .max(-self.solid.shape.drilled(x))
+        self.undrilled_value(x).max(-self.solid.shape.drilled(x))
     }
 
     fn clearance(&self, x: Vec3) -> f64 {
