@@ -338,11 +338,10 @@ fn tile_result(
     let inside = |e: [i32; 3], m: i64| own.grown(m).contains(e.map(|x| x as i64));
     let ours = |q: usize| inside(mesh.edges[q], 0);
     let mut shells = None;
+    let every_kept = || (0..mesh.quads.len()).filter(|&q| ours(q)).collect();
+    let every_vertex = || mesh.keys.iter().filter(|k| inside(k.voxel, 0)).count() as u64;
     let (kept, vertices): (Vec<usize>, u64) = match pieces {
-        Pieces::Keep => (
-            (0..mesh.quads.len()).filter(|&q| ours(q)).collect(),
-            mesh.keys.iter().filter(|k| inside(k.voxel, 0)).count() as u64,
-        ),
+        Pieces::Keep => (every_kept(), every_vertex()),
         Pieces::Find => {
             let found = Shells::of_quads(mesh, ours);
             let seams: Vec<(VertexKey, u32)> = (0..mesh.keys.len())
@@ -350,10 +349,7 @@ fn tile_result(
                 .map(|v| (mesh.keys[v], found.of_vertex[v]))
                 .collect();
             shells = Some((found, seams));
-            (
-                (0..mesh.quads.len()).filter(|&q| ours(q)).collect(),
-                mesh.keys.iter().filter(|k| inside(k.voxel, 0)).count() as u64,
-            )
+            (every_kept(), every_vertex())
         }
         Pieces::Drop(p) => {
             let found = Shells::of_quads(mesh, ours);
