@@ -65,6 +65,7 @@ pub mod interpret;
 pub mod io;
 pub mod mesh;
 pub mod progress;
+pub mod render;
 pub mod repair;
 pub mod strut;
 pub mod topopt;

@@ -60,6 +60,10 @@ enum Command {
     /// and adaptive B-spline fitting (Liu et al., Engineering 2018).
     #[command(after_help = cli::topo::EXAMPLES)]
     Topo(cli::topo::TopoArgs),
+    /// Render a picture of a part file, sphere-traced from its implicit solid without meshing
+    /// it, or of a mesh file, ray cast.
+    #[command(after_help = cli::render::EXAMPLES)]
+    Render(cli::render::RenderArgs),
     /// Run many jobs from a TOML job file: sweeps, workers, resume after a kill, Slurm arrays.
     #[command(after_help = cli::batch::EXAMPLES)]
     Batch(cli::batch::BatchArgs),
@@ -158,6 +162,7 @@ fn main() {
         Command::Topopt(a) => cli::topopt::run(a, cli.quiet),
         Command::Topo(a) => cli::topo::run(a, cli.quiet),
         Command::Batch(a) => cli::batch::run(a, cli.quiet),
+        Command::Render(a) => cli::render::run(a),
     };
     let result = result.and_then(|code| {
         if let Some((name, path, sub)) = &save_part {

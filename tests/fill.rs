@@ -8,34 +8,13 @@
 mod common;
 mod meshkit;
 use common::*;
-use meshkit::write_stl;
+use meshkit::{torus as torus_tris, write_stl};
 use std::f64::consts::PI;
 use std::path::Path;
 
 /// A box `[lo, lo + size]`.
 fn box_tris(lo: [f64; 3], size: [f64; 3]) -> Vec<Tri> {
     meshkit::cuboid(lo, [0, 1, 2].map(|a| lo[a] + size[a]))
-}
-
-/// A torus of radii `big` and `small` about the z axis, `nu × nv` quads, wound outward.
-fn torus_tris(big: f64, small: f64, nu: usize, nv: usize) -> Vec<Tri> {
-    let p = |i: usize, j: usize| {
-        let (u, v) = (
-            2.0 * PI * i as f64 / nu as f64,
-            2.0 * PI * j as f64 / nv as f64,
-        );
-        let r = big + small * v.cos();
-        [r * u.cos(), r * u.sin(), small * v.sin()]
-    };
-    let mut t = Vec::new();
-    for i in 0..nu {
-        for j in 0..nv {
-            let (a, b, c, d) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
-            t.push([a, b, c]);
-            t.push([a, c, d]);
-        }
-    }
-    t
 }
 
 fn torus_volume(big: f64, small: f64) -> f64 {

@@ -10,6 +10,7 @@
 //! A subcommand joins the batch by implementing [`Task`] for its `Args` and adding one line to
 //! [`COMMANDS`].
 
+use super::clap_message;
 use super::fill::FillArgs;
 use super::out::outln;
 use super::repair::RepairArgs;
@@ -241,17 +242,6 @@ fn command_line(cmd: &clap::Command, job: &Job) -> std::result::Result<Vec<Strin
 }
 
 /// clap's error as one line, keeping its "similar argument" tip.
-fn clap_message(e: clap::Error) -> String {
-    let text = e.render().to_string();
-    let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
-    let first = lines.next().unwrap_or("invalid options");
-    let first = first.strip_prefix("error: ").unwrap_or(first).to_string();
-    match lines.find(|l| l.starts_with("tip:")) {
-        Some(tip) => format!("{first} ({tip})"),
-        None => first,
-    }
-}
-
 fn task_for(job: &Job) -> Result<Box<dyn Task>> {
     let known = || COMMANDS.iter().map(|c| c.0).collect::<Vec<_>>().join(", ");
     let (name, parse) = COMMANDS

@@ -7,6 +7,7 @@ pub mod fill;
 pub mod lattice;
 pub(crate) mod out;
 pub mod part;
+pub mod render;
 pub mod repair;
 pub mod strut;
 pub mod topo;
@@ -125,6 +126,18 @@ pub(crate) fn parse_tile(s: &str) -> std::result::Result<i64, String> {
         _ => Err(format!(
             "tile must be a multiple of 8 voxels, at least 16, got '{s}'"
         )),
+    }
+}
+
+/// A clap error as one line: its first line, with its tip where it gives one.
+pub(crate) fn clap_message(e: clap::Error) -> String {
+    let text = e.render().to_string();
+    let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+    let first = lines.next().unwrap_or("invalid options");
+    let first = first.strip_prefix("error: ").unwrap_or(first).to_string();
+    match lines.find(|l| l.starts_with("tip:")) {
+        Some(tip) => format!("{first} ({tip})"),
+        None => first,
     }
 }
 

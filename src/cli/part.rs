@@ -147,6 +147,18 @@ fn arg_of(v: &toml::Value) -> Option<String> {
     })
 }
 
+/// A part file's table.
+pub(crate) fn read(path: &Path) -> Result<toml::Table> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    text.parse().map_err(|e: toml::de::Error| {
+        Error::invalid(format!(
+            "{}: not a part file: {}",
+            path.display(),
+            e.message()
+        ))
+    })
+}
+
 /// `argv` (a subcommand's arguments, after its name) with the options of the part file it
 /// names with `--part` put in front, those the command line gives itself left out.
 pub fn expand(command: &str, argv: Vec<String>) -> Result<Vec<String>> {
@@ -162,14 +174,7 @@ pub fn expand(command: &str, argv: Vec<String>) -> Result<Vec<String>> {
             .ok_or_else(|| Error::invalid("--part needs a part file (FILE.toml)"))?,
     };
     let path = Path::new(&path);
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
-        Error::invalid(format!(
-            "{}: not a part file: {}",
-            path.display(),
-            e.message()
-        ))
-    })?;
+    let table = read(path)?;
     match table.get("command").and_then(toml::Value::as_str) {
         Some(c) if c == command => {}
         Some(c) => {

@@ -90,24 +90,32 @@ pub fn run(a: &TpmsArgs, quiet: bool) -> Result<i32> {
 /// Runs the job and writes its mesh atomically; returns the report (output and write time
 /// filled in), for `run` to print and `latvox batch` to record.
 pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<TpmsReport> {
-    let m = &a.mesh;
-    let o = m.options();
-    let job = TpmsJob {
-        surface: a.surface,
-        structure: a.structure,
-        density: a.density,
-        domain: a.domain.domain()?,
-        resolution: m.resolution,
-        adaptivity: o.adaptivity,
-        allow_islands: a.allow_islands,
-        auto_resolution: !m.fixed_resolution,
-        verify: o.verify,
-        instancing: o.instancing,
-        tile: o.tile,
-        memory: o.memory,
-        keep_fragments: o.keep_fragments,
-    };
-    m.write(|sink| job.run_into(progress, sink), |r| &mut r.part)
+    let job = a.job()?;
+    a.mesh
+        .write(|sink| job.run_into(progress, sink), |r| &mut r.part)
+}
+
+impl TpmsArgs {
+    /// The job the options describe.
+    pub fn job(&self) -> Result<TpmsJob> {
+        let m = &self.mesh;
+        let o = m.options();
+        Ok(TpmsJob {
+            surface: self.surface,
+            structure: self.structure,
+            density: self.density,
+            domain: self.domain.domain()?,
+            resolution: m.resolution,
+            adaptivity: o.adaptivity,
+            allow_islands: self.allow_islands,
+            auto_resolution: !m.fixed_resolution,
+            verify: o.verify,
+            instancing: o.instancing,
+            tile: o.tile,
+            memory: o.memory,
+            keep_fragments: o.keep_fragments,
+        })
+    }
 }
 
 fn print_tpms_summary(r: &TpmsReport) {

@@ -22,6 +22,12 @@ pub trait Field: Sync {
     /// A lower bound on the distance from `p` to the surface `value = 0`.
     fn clearance(&self, p: Vec3) -> f64;
 
+    /// [`Field::value`] and [`Field::clearance`] at one point, for callers that need both (a
+    /// sphere tracer's step); fields that compute both from the same evaluation override it.
+    fn value_and_clearance(&self, p: Vec3) -> (f64, f64) {
+        (self.value(p), self.clearance(p))
+    }
+
     /// The implicit function and its gradient at `p`: any function with the same zero set and
     /// sign as `value`, smooth near the surface (used for Newton projection onto the surface).
     /// The default differentiates `value` numerically.
@@ -55,6 +61,9 @@ impl<T: Field + ?Sized> Field for &T {
     fn clearance(&self, p: Vec3) -> f64 {
         (**self).clearance(p)
     }
+    fn value_and_clearance(&self, p: Vec3) -> (f64, f64) {
+        (**self).value_and_clearance(p)
+    }
     fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
         (**self).implicit_with_gradient(p)
     }
@@ -79,6 +88,26 @@ pub fn numeric_gradient(f: impl Fn(Vec3) -> f64, p: Vec3) -> Vec3 {
 pub fn smooth_min(a: f64, b: f64, k: f64) -> f64 {
     let h = (k - (a - b).abs()).max(0.0) / k;
     a.min(b) - 0.25 * h * h * k
+}
+
+/// The clearance of `max(a, b)` from the operands' values and clearances: its surface lies on
+/// `a`'s or `b`'s and inside both, so from a point outside either operand, that operand's
+/// clearance alone is a valid bound.
+pub fn intersection_clearance(a: f64, ca: f64, b: f64, cb: f64) -> f64 {
+    let mut c = ca.min(cb);
+    if a > 0.0 {
+        c = c.max(ca);
+    }
+    if b > 0.0 {
+        c = c.max(cb);
+    }
+    c
+}
+
+/// The clearance of `min(a, b)`: its surface lies on `a`'s or `b`'s and outside both, so from
+/// inside either operand, that operand's clearance alone is a valid bound.
+pub fn union_clearance(a: f64, ca: f64, b: f64, cb: f64) -> f64 {
+    intersection_clearance(-a, ca, -b, cb)
 }
 
 /// An axis-aligned box `[min, max]`, as an exact signed distance field.
@@ -155,17 +184,13 @@ impl<A: Field, B: Field> Field for Intersection<A, B> {
     }
 
     fn clearance(&self, p: Vec3) -> f64 {
-        // The surface of A∩B lies on ∂A or ∂B, and inside both: from a point outside either
-        // operand, that operand's clearance alone is a valid bound.
-        let (ca, cb) = (self.a.clearance(p), self.b.clearance(p));
-        let mut c = ca.min(cb);
-        if self.a.value(p) > 0.0 {
-            c = c.max(ca);
-        }
-        if self.b.value(p) > 0.0 {
-            c = c.max(cb);
-        }
-        c
+        self.value_and_clearance(p).1
+    }
+
+    fn value_and_clearance(&self, p: Vec3) -> (f64, f64) {
+        let (a, ca) = self.a.value_and_clearance(p);
+        let (b, cb) = self.b.value_and_clearance(p);
+        (a.max(b), intersection_clearance(a, ca, b, cb))
     }
 
     fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {

@@ -23,7 +23,7 @@
 //! deep as the skin, the blend, a voxel and half a hole.
 
 use crate::error::Result;
-use crate::field::{smooth_min, Aabb, Field, Vec3};
+use crate::field::{intersection_clearance, smooth_min, union_clearance, Aabb, Field, Vec3};
 use crate::grid::{Grid, GridSpec};
 use crate::mesh::pipeline::{Family, Solid, HALF_WIDTH};
 use crate::mesh::Mesh;
@@ -221,25 +221,6 @@ impl<S: Solid + Clone> Solid for FillSolid<S> {
 struct FillField<'a, S> {
     solid: &'a FillSolid<S>,
     lattice: Option<Box<dyn Field + 'a>>,
-}
-
-/// The clearance of `max(a, b)`: its surface lies on `a`'s or `b`'s and inside both, so from
-/// outside either, that one's clearance alone bounds it.
-fn intersection_clearance(a: f64, ca: f64, b: f64, cb: f64) -> f64 {
-    let mut c = ca.min(cb);
-    if a > 0.0 {
-        c = c.max(ca);
-    }
-    if b > 0.0 {
-        c = c.max(cb);
-    }
-    c
-}
-
-/// The clearance of `min(a, b)`: its surface lies on `a`'s or `b`'s and outside both, so from
-/// inside either, that one's clearance alone bounds it.
-fn union_clearance(a: f64, ca: f64, b: f64, cb: f64) -> f64 {
-    intersection_clearance(-a, ca, -b, cb)
 }
 
 impl<S: Solid> FillField<'_, S> {

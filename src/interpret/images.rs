@@ -30,15 +30,7 @@ impl Canvas {
     }
 
     fn save(&self, path: &Path) -> Result<()> {
-        crate::io::atomic::write_atomic(path, |w| {
-            let mut e = png::Encoder::new(w, self.w as u32, self.h as u32);
-            e.set_color(png::ColorType::Rgb);
-            e.set_depth(png::BitDepth::Eight);
-            let mut wr = e.write_header().map_err(std::io::Error::other)?;
-            wr.write_image_data(&self.rgb)
-                .map_err(std::io::Error::other)?;
-            wr.finish().map_err(std::io::Error::other)
-        })
+        crate::io::png::write_rgb(path, self.w as u32, self.h as u32, &self.rgb)
     }
 }
 

@@ -13,6 +13,7 @@ pub mod npy;
 pub mod obj;
 pub mod off;
 pub mod ply;
+pub mod png;
 pub mod sink;
 pub mod stl;
 pub mod threemf;

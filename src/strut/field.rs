@@ -257,6 +257,11 @@ impl Field for StrutField {
         self.value(p).abs()
     }
 
+    fn value_and_clearance(&self, p: Vec3) -> (f64, f64) {
+        let v = self.value(p);
+        (v, v.abs())
+    }
+
     /// With sharp joins, the nearest strut's distance and gradient, from two passes over the
     /// struts of `p`'s bin instead of seven. Where struts tie for nearest (within the step
     /// central differences would take: on the mirror planes of a symmetric node, which the voxel

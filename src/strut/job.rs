@@ -194,6 +194,30 @@ impl StrutJob {
         Ok((collector.mesh, report))
     }
 
+    /// The part as an implicit solid at the radius given, or the one the radius model gives for
+    /// the density.
+    pub fn model(&self) -> Result<crate::render::Model> {
+        self.validate()?;
+        let bounds = self.domain.bounds();
+        let radius = match self.sizing {
+            Sizing::Radius(r) => r,
+            Sizing::Density(d) => RadiusModel::new(&self.cell, self.domain.cell).radius(d),
+        };
+        let c = self.domain.cell;
+        Ok(crate::render::Model {
+            solid: Box::new(StrutLattice {
+                cell: self.cell.clone(),
+                size: c,
+                radius,
+                blend: self.blend,
+                bounds,
+                phase: bounds.min,
+            }),
+            voxel: self.voxel(self.resolution),
+            cell: c[0].min(c[1]).min(c[2]),
+        })
+    }
+
     /// The voxel edge at `resolution` voxels per cell, mm.
     fn voxel(&self, resolution: u32) -> f64 {
         let c = self.domain.cell;

@@ -97,6 +97,26 @@ impl TpmsReport {
 }
 
 impl TpmsJob {
+    /// The part as an implicit solid at the level the analytic model gives for the density.
+    pub fn model(&self) -> Result<crate::render::Model> {
+        self.validate()?;
+        let bounds = self.domain.bounds();
+        let cell = self.domain.cell;
+        let min_cell = cell[0].min(cell[1]).min(cell[2]);
+        Ok(crate::render::Model {
+            solid: Box::new(Lattice {
+                surface: self.surface,
+                structure: self.structure,
+                level: calibrate::analytic_level(self.surface, self.structure, self.density),
+                cell,
+                bounds,
+                phase: bounds.min,
+            }),
+            voxel: min_cell / self.resolution as f64,
+            cell: min_cell,
+        })
+    }
+
     fn validate(&self) -> Result<()> {
         resolution::check_density(self.density)?;
         resolution::check_resolution(self.resolution)?;

@@ -419,6 +419,11 @@ impl Field for TpmsField {
         self.implicit(self.raw(p)).abs() / self.lipschitz
     }
 
+    fn value_and_clearance(&self, p: Vec3) -> (f64, f64) {
+        let (f, g) = self.surface.eval(self.cell_coords(p));
+        (self.distance(f, g), self.implicit(f).abs() / self.lipschitz)
+    }
+
     fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
         let (f, g) = self.surface.eval(self.cell_coords(p));
         let sign = match self.structure {

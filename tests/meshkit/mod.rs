@@ -344,6 +344,27 @@ pub fn intersecting_pairs(tris: &[Tri]) -> usize {
     n
 }
 
+/// A torus of radii `big` and `small` about the z axis, `nu × nv` quads, wound outward.
+pub fn torus(big: f64, small: f64, nu: usize, nv: usize) -> Vec<Tri> {
+    let p = |i: usize, j: usize| {
+        let (u, v) = (
+            2.0 * std::f64::consts::PI * i as f64 / nu as f64,
+            2.0 * std::f64::consts::PI * j as f64 / nv as f64,
+        );
+        let r = big + small * v.cos();
+        [r * u.cos(), r * u.sin(), small * v.sin()]
+    };
+    let mut t = Vec::new();
+    for i in 0..nu {
+        for j in 0..nv {
+            let (a, b, c, d) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
+            t.push([a, b, c]);
+            t.push([a, c, d]);
+        }
+    }
+    t
+}
+
 /// An axis-aligned box, 12 facets wound outward.
 pub fn cuboid(lo: P, hi: P) -> Vec<Tri> {
     let c = |i: usize| {

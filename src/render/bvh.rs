@@ -1,0 +1,341 @@
+//! A bounding volume hierarchy over a mesh's triangles, for casting rays at explicit shells.
+//!
+//! Built top-down with the surface-area heuristic over 16 bins of triangle centroids (leaves
+//! of at most 4 triangles). A ray visits the nearer child first and skips every node whose box
+//! it enters beyond the nearest hit found so far, so a ray costs about the logarithm of the
+//! triangle count; a ray that starts inside a box (the camera inside the part) enters it at 0.
+//! Triangles are hit from both sides (Möller–Trumbore), so open shells render too.
+
+use super::camera::{cross, dot, Ray};
+use crate::field::{Aabb, Vec3};
+use crate::mesh::Mesh;
+
+const LEAF: usize = 4;
+const BINS: usize = 16;
+
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    bounds: Aabb,
+    /// Inner node: index of the first child (the second follows it). Leaf: first triangle.
+    first: u32,
+    /// Triangles in a leaf; 0 for an inner node.
+    count: u32,
+}
+
+/// Triangles and the hierarchy over them.
+#[derive(Debug, Clone)]
+pub struct Bvh {
+    triangles: Vec<[Vec3; 3]>,
+    nodes: Vec<Node>,
+}
+
+/// Where a ray meets a triangle.
+#[derive(Debug, Clone, Copy)]
+pub struct TriangleHit {
+    /// Distance along the ray.
+    pub t: f64,
+    /// The triangle's unit normal by its winding.
+    pub normal: Vec3,
+}
+
+fn empty_box() -> Aabb {
+    Aabb {
+        min: [f64::INFINITY; 3],
+        max: [f64::NEG_INFINITY; 3],
+    }
+}
+
+fn grow(b: &mut Aabb, p: Vec3) {
+    b.min = [0, 1, 2].map(|a| b.min[a].min(p[a]));
+    b.max = [0, 1, 2].map(|a| b.max[a].max(p[a]));
+}
+
+fn union(a: &Aabb, b: &Aabb) -> Aabb {
+    Aabb {
+        min: [0, 1, 2].map(|k| a.min[k].min(b.min[k])),
+        max: [0, 1, 2].map(|k| a.max[k].max(b.max[k])),
+    }
+}
+
+fn area(b: &Aabb) -> f64 {
+    let s = b.size().map(|x| x.max(0.0));
+    s[0] * s[1] + s[1] * s[2] + s[2] * s[0]
+}
+
+impl Bvh {
+    /// The hierarchy over `mesh`'s triangles.
+    pub fn new(mesh: &Mesh) -> Bvh {
+        let p = |i: u32| {
+            let o = 3 * i as usize;
+            [0, 1, 2].map(|a| mesh.positions[o + a] as f64)
+        };
+        let mut triangles: Vec<[Vec3; 3]> = mesh
+            .indices
+            .chunks_exact(3)
+            .map(|t| [p(t[0]), p(t[1]), p(t[2])])
+            .collect();
+        let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF + 1);
+        if !triangles.is_empty() {
+            nodes.push(Node {
+                bounds: empty_box(),
+                first: 0,
+                count: 0,
+            });
+            let n = triangles.len();
+            build(&mut triangles, &mut nodes, 0, 0, n);
+        }
+        Bvh { triangles, nodes }
+    }
+
+    /// The box of every triangle, or `None` for an empty mesh.
+    pub fn bounds(&self) -> Option<Aabb> {
+        self.nodes.first().map(|n| n.bounds)
+    }
+
+    /// Triangles held.
+    pub fn len(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Whether it holds no triangle.
+    pub fn is_empty(&self) -> bool {
+        self.triangles.is_empty()
+    }
+
+    /// The nearest triangle the ray meets at a distance in `(0, t_max)`.
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<TriangleHit> {
+        let mut best: Option<(f64, usize)> = None;
+        let mut limit = t_max;
+        let root = self.nodes.first()?;
+        if !enters_before(ray, &root.bounds, limit) {
+            return None;
+        }
+        // Nodes to visit, with the distance at which the ray enters them.
+        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        stack.push((0, 0.0));
+        while let Some((i, t_in)) = stack.pop() {
+            // Entered beyond the nearest hit found since it was pushed: nothing nearer inside.
+            if t_in >= limit {
+                continue;
+            }
+            let node = &self.nodes[i as usize];
+            if node.count > 0 {
+                let first = node.first as usize;
+                for (k, tri) in self.triangles[first..first + node.count as usize]
+                    .iter()
+                    .enumerate()
+                {
+                    if let Some(t) = intersect(ray, tri) {
+                        if t < limit {
+                            limit = t;
+                            best = Some((t, first + k));
+                        }
+                    }
+                }
+                continue;
+            }
+            let (a, b) = (node.first, node.first + 1);
+            let ta = entry(ray, &self.nodes[a as usize].bounds, limit);
+            let tb = entry(ray, &self.nodes[b as usize].bounds, limit);
+            // The nearer child is visited first: pushed last.
+            match (ta, tb) {
+                (Some(x), Some(y)) if x <= y => {
+                    stack.push((b, y));
+                    stack.push((a, x));
+                }
+                (Some(x), Some(y)) => {
+                    stack.push((a, x));
+                    stack.push((b, y));
+                }
+                (Some(x), None) => stack.push((a, x)),
+                (None, Some(y)) => stack.push((b, y)),
+                (None, None) => {}
+            }
+        }
+        best.map(|(t, i)| {
+            let [a, b, c] = self.triangles[i];
+            let n = cross(sub(b, a), sub(c, a));
+            let len = dot(n, n).sqrt();
+            TriangleHit {
+                t,
+                normal: if len > 0.0 { n.map(|x| x / len) } else { n },
+            }
+        })
+    }
+}
+
+fn sub(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn entry(ray: &Ray, b: &Aabb, limit: f64) -> Option<f64> {
+    ray.clip(b).and_then(|(t0, _)| (t0 < limit).then_some(t0))
+}
+
+fn enters_before(ray: &Ray, b: &Aabb, limit: f64) -> bool {
+    entry(ray, b, limit).is_some()
+}
+
+/// Möller–Trumbore: the distance at which the ray crosses the triangle, from either side.
+fn intersect(ray: &Ray, tri: &[Vec3; 3]) -> Option<f64> {
+    let e1 = sub(tri[1], tri[0]);
+    let e2 = sub(tri[2], tri[0]);
+    let p = cross(ray.dir, e2);
+    let det = dot(e1, p);
+    if det.abs() < 1e-300 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = sub(ray.origin, tri[0]);
+    let u = dot(s, p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = cross(s, e1);
+    let v = dot(ray.dir, q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let t = dot(e2, q) * inv;
+    (t > 0.0).then_some(t)
+}
+
+fn centroid(t: &[Vec3; 3]) -> Vec3 {
+    [0, 1, 2].map(|a| (t[0][a] + t[1][a] + t[2][a]) / 3.0)
+}
+
+/// Builds node `at` over `triangles[lo..hi]`, reordering them.
+fn build(triangles: &mut [[Vec3; 3]], nodes: &mut Vec<Node>, at: usize, lo: usize, hi: usize) {
+    let mut bounds = empty_box();
+    let mut cbounds = empty_box();
+    for t in &triangles[lo..hi] {
+        for &p in t {
+            grow(&mut bounds, p);
+        }
+        grow(&mut cbounds, centroid(t));
+    }
+    nodes[at].bounds = bounds;
+    let n = hi - lo;
+    let leaf = |nodes: &mut Vec<Node>| {
+        nodes[at].first = lo as u32;
+        nodes[at].count = n as u32;
+    };
+    if n <= LEAF {
+        return leaf(nodes);
+    }
+    // The split of least surface-area cost over the bins of every axis.
+    let mut best: Option<(f64, usize, f64)> = None;
+    for axis in 0..3 {
+        let (c0, c1) = (cbounds.min[axis], cbounds.max[axis]);
+        if c1 - c0 <= 0.0 {
+            continue;
+        }
+        let scale = BINS as f64 / (c1 - c0);
+        let bin_of = |t: &[Vec3; 3]| (((centroid(t)[axis] - c0) * scale) as usize).min(BINS - 1);
+        let mut counts = [0usize; BINS];
+        let mut boxes = [empty_box(); BINS];
+        for t in &triangles[lo..hi] {
+            let b = bin_of(t);
+            counts[b] += 1;
+            for &p in t {
+                grow(&mut boxes[b], p);
+            }
+        }
+        let mut right_area = [0.0; BINS];
+        let mut right_count = [0usize; BINS];
+        let (mut acc, mut cnt) = (empty_box(), 0);
+        for b in (1..BINS).rev() {
+            acc = union(&acc, &boxes[b]);
+            cnt += counts[b];
+            right_area[b] = area(&acc);
+            right_count[b] = cnt;
+        }
+        let (mut acc, mut cnt) = (empty_box(), 0);
+        for b in 0..BINS - 1 {
+            acc = union(&acc, &boxes[b]);
+            cnt += counts[b];
+            if cnt == 0 || right_count[b + 1] == 0 {
+                continue;
+            }
+            let cost = area(&acc) * cnt as f64 + right_area[b + 1] * right_count[b + 1] as f64;
+            if best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, axis, c0 + (b + 1) as f64 / scale));
+            }
+        }
+    }
+    let mid = match best {
+        Some((_, axis, split)) => {
+            let mut m = lo;
+            for i in lo..hi {
+                if centroid(&triangles[i])[axis] < split {
+                    triangles.swap(i, m);
+                    m += 1;
+                }
+            }
+            m
+        }
+        None => lo + n / 2,
+    };
+    let mid = if mid == lo || mid == hi {
+        lo + n / 2
+    } else {
+        mid
+    };
+    let first = nodes.len();
+    let blank = Node {
+        bounds: empty_box(),
+        first: 0,
+        count: 0,
+    };
+    nodes.push(blank);
+    nodes.push(blank);
+    nodes[at].first = first as u32;
+    nodes[at].count = 0;
+    build(triangles, nodes, first, lo, mid);
+    build(triangles, nodes, first + 1, mid, hi);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every ray's nearest hit is the one found by testing every triangle.
+    #[test]
+    fn nearest_hit_is_the_brute_force_one() {
+        // A cloud of small random triangles.
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64) / (1u64 << 53) as f64
+        };
+        let mut mesh = Mesh::default();
+        for i in 0..500u32 {
+            let c = [rnd() * 10.0, rnd() * 10.0, rnd() * 10.0];
+            for _ in 0..3 {
+                for x in c {
+                    mesh.positions.push((x + rnd() - 0.5) as f32);
+                }
+            }
+            mesh.indices.extend([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        let bvh = Bvh::new(&mesh);
+        for _ in 0..500 {
+            let origin = [rnd() * 14.0 - 2.0, rnd() * 14.0 - 2.0, rnd() * 14.0 - 2.0];
+            let d = [rnd() - 0.5, rnd() - 0.5, rnd() - 0.5];
+            let n = dot(d, d).sqrt();
+            let ray = Ray {
+                origin,
+                dir: d.map(|x| x / n),
+            };
+            let brute = bvh
+                .triangles
+                .iter()
+                .filter_map(|t| intersect(&ray, t))
+                .fold(f64::INFINITY, f64::min);
+            let got = bvh.hit(&ray, f64::INFINITY).map_or(f64::INFINITY, |h| h.t);
+            assert_eq!(got, brute);
+        }
+    }
+}
