@@ -10,7 +10,9 @@ namespace latvox {
 
 void vdb_probe(const VdbGrid& grid, rust::Slice<const double> points, rust::Slice<float> values) {
   const openvdb::FloatGrid& g = *grid.impl->grid;
-  auto acc = g.getConstAccessor();
+  // Not registered with the tree (no lock, no hash-map entry made and erased per call): the
+  // grid is not changed while it is probed, and probes come one point at a time when tracing.
+  openvdb::tree::ValueAccessor<const openvdb::FloatTree, false> acc(g.tree());
   const auto& xform = g.transform();
   const std::size_t n = std::min(points.size() / 3, values.size());
   for (std::size_t i = 0; i < n; ++i) {

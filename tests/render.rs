@@ -47,12 +47,12 @@ fn edges(d: &[f64], h: usize, w: usize, jump: f64) -> Vec<bool> {
     out
 }
 
-/// Renders `part.toml` and `part.stl` in `dir` from `view` and compares them: the share of
-/// pixels where both hit or both miss, and the share of pixels away from edges in both where
-/// both hit and the depths agree within `voxel`.
-fn compare(dir: &Path, view: &str, distance: f64, voxel: f64) -> (f64, f64, usize) {
+/// Renders `part.toml` and `part.stl` in `dir` from `view` (with `extra` options) and compares
+/// them: the share of pixels where both hit or both miss, and the share of pixels away from
+/// edges in both where both hit and the depths agree within `voxel`.
+fn compare(dir: &Path, view: &str, extra: &[&str], distance: f64, voxel: f64) -> (f64, f64, usize) {
     for (input, out) in [("part.toml", "implicit.npy"), ("part.stl", "mesh.npy")] {
-        let args = [
+        let mut args = vec![
             "render",
             input,
             "-o",
@@ -66,8 +66,10 @@ fn compare(dir: &Path, view: &str, distance: f64, voxel: f64) -> (f64, f64, usiz
             "--height",
             "450",
             "--distance",
-            &distance.to_string(),
         ];
+        let distance = distance.to_string();
+        args.push(&distance);
+        args.extend_from_slice(extra);
         ok(&args, dir);
     }
     let (a, h, w) = depth(&dir.join("implicit.npy"));
@@ -115,7 +117,7 @@ fn make(dir: &Path, args: &[&str]) {
 /// lattice grazes a face of its box, which the implicit shows and the mesh cannot).
 #[test]
 fn a_part_renders_as_its_mesh_does() {
-    let cases: [(&str, Vec<&str>, f64, f64); 3] = [
+    let cases: [(&str, Vec<&str>, f64, f64, &str); 3] = [
         (
             "tpms",
             vec![
@@ -129,6 +131,7 @@ fn a_part_renders_as_its_mesh_does() {
             ],
             5.0 / 32.0,
             50.0,
+            "z=7.3",
         ),
         (
             "strut",
@@ -147,6 +150,7 @@ fn a_part_renders_as_its_mesh_does() {
             ],
             4.0 / 32.0,
             45.0,
+            "z=5.1",
         ),
         (
             "fill",
@@ -163,18 +167,45 @@ fn a_part_renders_as_its_mesh_does() {
                 "0.8",
                 "--resolution",
                 "16",
+                "--drain",
+                "2",
+                "--keep",
+                "boss.stl",
             ],
             4.0 / 16.0,
             90.0,
+            "z=0.6",
         ),
     ];
-    for (name, args, voxel, distance) in cases {
+    for (name, args, voxel, distance, cut) in cases {
         let dir = tempdir();
         let d = dir.path();
         meshkit::write_stl(&d.join("torus.stl"), &meshkit::torus(12.0, 4.0, 192, 96));
+        meshkit::write_stl(
+            &d.join("boss.stl"),
+            &meshkit::cuboid([9.0, -3.0, -6.0], [17.0, 3.0, 6.0]),
+        );
         make(d, &args);
+        // Cut open, the implicit's caps are where the mesh (not capped) shows its inside: the
+        // silhouettes still agree, the depths only away from the cut.
+        let (silhouette, _, _) = compare(d, "top", &["--section", cut], distance, voxel);
+        let (cut_depth, _, _) = depth(&d.join("implicit.npy"));
+        let seen = cut_depth.iter().filter(|v| v.is_finite()).count();
+        assert!(
+            seen * 10 > cut_depth.len(),
+            "{name} cut: part on {seen} pixels"
+        );
+        eprintln!(
+            "{name} cut: silhouettes agree on {:.3} %",
+            100.0 * silhouette
+        );
+        assert!(
+            silhouette >= 0.995,
+            "{name} cut: silhouettes agree on {:.3} % of pixels",
+            100.0 * silhouette
+        );
         for view in ["iso", "top", "front"] {
-            let (silhouette, depth, n) = compare(d, view, distance, voxel);
+            let (silhouette, depth, n) = compare(d, view, &[], distance, voxel);
             eprintln!(
                 "{name} {view}: silhouettes agree on {:.3} %, depth within a voxel on {:.3} % of {n}",
                 100.0 * silhouette,

@@ -4,6 +4,7 @@
 use super::out::outln;
 use super::{clap_message, emit_json, parse_f64};
 use clap::{Args, FromArgMatches};
+use latvox::fill::traced::Traced;
 use latvox::render::camera::{Camera, View};
 use latvox::render::trace::{Implicit, Scene, Section, Triangles};
 use latvox::render::{bvh::Bvh, render, Frame, Model};
@@ -134,8 +135,17 @@ struct Rendered {
     seconds: f64,
 }
 
-/// A part file's job as an implicit model.
-pub(crate) fn model_of(path: &Path) -> Result<Model> {
+/// What a part file describes, ready to trace: a lattice block as an implicit model, or a
+/// filled part as its meshes and lattice.
+pub(crate) enum Part {
+    /// A TPMS or strut part.
+    Block(Model),
+    /// A filled part.
+    Filled(Box<Traced>),
+}
+
+/// A part file's part.
+pub(crate) fn part_of(path: &Path) -> Result<Part> {
     let table = super::part::read(path)?;
     let command = table
         .get("command")
@@ -144,11 +154,21 @@ pub(crate) fn model_of(path: &Path) -> Result<Model> {
         .to_string();
     let argv = vec!["--part".to_string(), path.display().to_string()];
     match command.as_str() {
-        "tpms" => parse::<super::tpms::TpmsArgs>("tpms", argv)?.job()?.model(),
-        "strut" => parse::<super::strut::StrutArgs>("strut", argv)?
-            .job()?
-            .model(),
-        "fill" => parse::<super::fill::FillArgs>("fill", argv)?.job()?.model(),
+        "tpms" => Ok(Part::Block(
+            parse::<super::tpms::TpmsArgs>("tpms", argv)?
+                .job()?
+                .model()?,
+        )),
+        "strut" => Ok(Part::Block(
+            parse::<super::strut::StrutArgs>("strut", argv)?
+                .job()?
+                .model()?,
+        )),
+        "fill" => Ok(Part::Filled(Box::new(
+            parse::<super::fill::FillArgs>("fill", argv)?
+                .job()?
+                .traced()?,
+        ))),
         _ => Err(Error::invalid(format!(
             "{}: a part file needs `command` (\"tpms\", \"strut\" or \"fill\")",
             path.display()
@@ -189,10 +209,19 @@ pub fn run(a: &RenderArgs) -> Result<i32> {
         latvox::io::atomic::check_writable(d)?;
     }
     let (frame, method) = if is_part_file(&a.input) {
-        let model = model_of(&a.input)?;
-        let field = model.field();
-        let scene = Implicit::new(&*field, model.bounds(), a.section, model.voxel, model.cell);
-        (views(a, &scene)?, "implicit")
+        let frame = match part_of(&a.input)? {
+            Part::Block(model) => {
+                let field = model.field();
+                let scene =
+                    Implicit::new(&*field, model.bounds(), a.section, model.voxel, model.cell);
+                views(a, &scene)?
+            }
+            Part::Filled(traced) => {
+                let field = traced.lattice_field();
+                views(a, &traced.scene(&*field, a.section))?
+            }
+        };
+        (frame, "implicit")
     } else {
         let loaded = latvox::io::read(&a.input, &Default::default())?;
         if loaded.mesh.indices.is_empty() {

@@ -11,7 +11,7 @@ use crate::check::Verdict;
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Vec3};
 use crate::io::sink::{MeshCollector, MeshSink};
-use crate::mesh::pipeline::{self, Family, Measured, MeshingStats, Options, Route, Solid};
+use crate::mesh::pipeline::{self, Family, Measured, MeshingStats, Options, Route};
 use crate::mesh::report::{LevelSearch, PartReport, Timings};
 use crate::mesh::resolution::{self, Resolved};
 use crate::mesh::Mesh;
@@ -171,69 +171,26 @@ impl FillJob {
     fn shape(&self, part: &Mesh, keep: &[Mesh], voxel: f64) -> Result<Arc<Shape>> {
         let mut shape = Shape::new(part, keep, voxel, self.skin + self.blend)?;
         if let (Some(d), true) = (self.drain, self.skin > 0.0) {
-            let b = part.bounds().expect("a part has triangles");
-            let least = (0..3)
-                .map(|a| b.max[a] - b.min[a])
-                .fold(f64::INFINITY, f64::min);
-            if d > 0.5 * least {
-                return Err(Error::invalid(format!(
-                    "a drain hole of {d} mm is too wide for {}: at most half its smallest extent, {} mm",
-                    self.part_name,
-                    0.5 * least
-                )));
-            }
+            self.check_drain(part, d)?;
             shape.drains = Drain::at_ends(part, d, self.skin + self.blend + voxel);
         }
         Ok(Arc::new(shape))
     }
 
-    /// The filled part as an implicit solid: the part's distance grid at the voxel meshing
-    /// uses, its lattice at the level (or radius) the lattice's model gives for the density.
-    pub fn model(&self) -> Result<crate::render::Model> {
-        self.validate()?;
-        let (part, _) = closed(&self.part, &self.part_name)?;
-        let keep = self
-            .keep
-            .iter()
-            .map(|(name, m)| closed(m, name).map(|(m, _)| m))
-            .collect::<Result<Vec<_>>>()?;
-        let voxel = self.min_cell() / self.resolution as f64;
-        let shape = self.shape(&part, &keep, voxel)?;
-        let b = shape.bounds;
-        let (skin, blend) = (self.skin, self.blend);
-        let solid: Box<dyn Solid + Send> = match &self.lattice {
-            Infilling::Tpms { surface, structure } => Box::new(FillSolid {
-                shape,
-                skin,
-                blend,
-                infill: Infill::Lattice(Lattice {
-                    surface: *surface,
-                    structure: *structure,
-                    level: calibrate::analytic_level(*surface, *structure, self.density),
-                    cell: self.cell,
-                    bounds: b,
-                    phase: b.min,
-                }),
-            }),
-            Infilling::Strut { cell } => Box::new(FillSolid {
-                shape,
-                skin,
-                blend,
-                infill: Infill::Lattice(StrutLattice {
-                    cell: cell.clone(),
-                    size: self.cell,
-                    radius: RadiusModel::new(cell, self.cell).radius(self.density),
-                    blend,
-                    bounds: b,
-                    phase: b.min,
-                }),
-            }),
-        };
-        Ok(crate::render::Model {
-            solid,
-            voxel,
-            cell: self.min_cell(),
-        })
+    /// Refuses a drain hole wider than half the part's smallest extent.
+    pub(super) fn check_drain(&self, part: &Mesh, d: f64) -> Result<()> {
+        let b = part.bounds().expect("a part has triangles");
+        let least = (0..3)
+            .map(|a| b.max[a] - b.min[a])
+            .fold(f64::INFINITY, f64::min);
+        if d > 0.5 * least {
+            return Err(Error::invalid(format!(
+                "a drain hole of {d} mm is too wide for {}: at most half its smallest extent, {} mm",
+                self.part_name,
+                0.5 * least
+            )));
+        }
+        Ok(())
     }
 
     fn validate(&self) -> Result<()> {
@@ -261,7 +218,7 @@ impl FillJob {
     }
 
     /// The shortest cell side, mm.
-    fn min_cell(&self) -> f64 {
+    pub(super) fn min_cell(&self) -> f64 {
         self.cell.iter().cloned().fold(f64::INFINITY, f64::min)
     }
 

@@ -76,7 +76,7 @@ pub struct Drain {
 
 impl Drain {
     /// Signed distance to the hole (negative inside).
-    fn distance(&self, p: Vec3) -> f64 {
+    pub(crate) fn distance(&self, p: Vec3) -> f64 {
         use crate::mesh::{dot, sub};
         let (ab, ap) = (sub(self.to, self.from), sub(p, self.from));
         let t = (dot(ap, ab) / dot(ab, ab)).clamp(0.0, 1.0);
@@ -281,6 +281,28 @@ impl<S: Solid> Field for FillField<'_, S> {
     }
 }
 
+/// The solid inside a part filled with a skin and a lattice — the skin where `core` (the depth
+/// below the skin, negative within it) is negative, or the lattice where `l` is, joined by a
+/// smooth minimum of radius `blend` — as a value and a clearance, from each one's value and
+/// clearance.
+pub(crate) fn skin_or_lattice(
+    (core, c_core): (f64, f64),
+    (l, cl): (f64, f64),
+    skin: f64,
+    blend: f64,
+) -> (f64, f64) {
+    if skin == 0.0 {
+        return (l, cl);
+    }
+    let c = union_clearance(core, c_core, l, cl);
+    // The smooth minimum moves the surface by up to its radius.
+    if blend > 0.0 {
+        (smooth_min(core, l, blend), (c - blend).max(0.0))
+    } else {
+        (core.min(l), c)
+    }
+}
+
 impl<S: Solid> FillField<'_, S> {
     /// The part's value before the drain holes.
     fn undrilled_value(&self, x: Vec3) -> f64 {
@@ -303,18 +325,9 @@ impl<S: Solid> FillField<'_, S> {
             Infill::Lattice(_) => {
                 let f = self.lattice.as_ref().expect("a lattice has a field");
                 let (l, cl) = (f.value(x), f.clearance(x));
-                let (sv, cs) = if s.skin == 0.0 {
-                    (l, cl)
-                } else {
-                    let core = -p - s.skin;
-                    let c = union_clearance(core, grid_clearance(core, h), l, cl);
-                    // The smooth minimum moves the surface by up to its radius.
-                    if s.blend > 0.0 {
-                        (smooth_min(core, l, s.blend), (c - s.blend).max(0.0))
-                    } else {
-                        (core.min(l), c)
-                    }
-                };
+                let core = -p - s.skin;
+                let (sv, cs) =
+                    skin_or_lattice((core, grid_clearance(core, h)), (l, cl), s.skin, s.blend);
                 intersection_clearance(p, cp, sv, cs)
             }
         };

@@ -162,6 +162,139 @@ impl Bvh {
             }
         })
     }
+
+    /// The distance from `p` to the nearest triangle, if nearer than `limit` (else `limit`).
+    pub fn distance(&self, p: Vec3, limit: f64) -> f64 {
+        let mut best2 = limit * limit;
+        let Some(root) = self.nodes.first() else {
+            return limit;
+        };
+        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        stack.push((0, box_distance2(&root.bounds, p)));
+        while let Some((i, d2)) = stack.pop() {
+            if d2 >= best2 {
+                continue;
+            }
+            let node = &self.nodes[i as usize];
+            if node.count > 0 {
+                let first = node.first as usize;
+                for tri in &self.triangles[first..first + node.count as usize] {
+                    best2 = best2.min(triangle_distance2(p, tri));
+                }
+                continue;
+            }
+            let (a, b) = (node.first, node.first + 1);
+            let da = box_distance2(&self.nodes[a as usize].bounds, p);
+            let db = box_distance2(&self.nodes[b as usize].bounds, p);
+            // The nearer child is visited first: pushed last.
+            if da <= db {
+                stack.push((b, db));
+                stack.push((a, da));
+            } else {
+                stack.push((a, da));
+                stack.push((b, db));
+            }
+        }
+        best2.sqrt()
+    }
+
+    /// Whether `p` is inside the closed surface the triangles bound: an odd number of them
+    /// crossed by a ray from `p` (along a direction no axis-aligned facet, edge or vertex of a
+    /// voxel-made mesh lies on).
+    pub fn contains(&self, p: Vec3) -> bool {
+        let dir = normalized_dir([0.5773, 0.5779, 0.5767]);
+        let ray = Ray { origin: p, dir };
+        let mut crossings = 0usize;
+        let Some(root) = self.nodes.first() else {
+            return false;
+        };
+        if ray.clip(&root.bounds).is_none() {
+            return false;
+        }
+        let mut stack = vec![0u32];
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i as usize];
+            if node.count > 0 {
+                let first = node.first as usize;
+                crossings += self.triangles[first..first + node.count as usize]
+                    .iter()
+                    .filter(|t| intersect(&ray, t).is_some())
+                    .count();
+                continue;
+            }
+            for c in [node.first, node.first + 1] {
+                if ray.clip(&self.nodes[c as usize].bounds).is_some() {
+                    stack.push(c);
+                }
+            }
+        }
+        crossings % 2 == 1
+    }
+}
+
+fn normalized_dir(d: Vec3) -> Vec3 {
+    let n = dot(d, d).sqrt();
+    d.map(|x| x / n)
+}
+
+/// The squared distance from `p` to the box (0 inside).
+fn box_distance2(b: &Aabb, p: Vec3) -> f64 {
+    (0..3)
+        .map(|a| {
+            let d = (b.min[a] - p[a]).max(p[a] - b.max[a]).max(0.0);
+            d * d
+        })
+        .sum()
+}
+
+/// The squared distance from `p` to the triangle (Ericson, Real-Time Collision Detection 5.1.5).
+fn triangle_distance2(p: Vec3, t: &[Vec3; 3]) -> f64 {
+    let [a, b, c] = *t;
+    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
+    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+    let q = if d1 <= 0.0 && d2 <= 0.0 {
+        a
+    } else {
+        let bp = sub(p, b);
+        let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+        if d3 >= 0.0 && d4 <= d3 {
+            b
+        } else {
+            let vc = d1 * d4 - d3 * d2;
+            if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+                let v = d1 / (d1 - d3);
+                lerp(a, ab, v)
+            } else {
+                let cp = sub(p, c);
+                let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+                if d6 >= 0.0 && d5 <= d6 {
+                    c
+                } else {
+                    let vb = d5 * d2 - d1 * d6;
+                    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+                        let w = d2 / (d2 - d6);
+                        lerp(a, ac, w)
+                    } else {
+                        let va = d3 * d6 - d5 * d4;
+                        if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+                            let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+                            lerp(b, sub(c, b), w)
+                        } else {
+                            let denom = 1.0 / (va + vb + vc);
+                            let (v, w) = (vb * denom, vc * denom);
+                            [0, 1, 2].map(|k| a[k] + ab[k] * v + ac[k] * w)
+                        }
+                    }
+                }
+            }
+        }
+    };
+    let d = sub(p, q);
+    dot(d, d)
+}
+
+fn lerp(a: Vec3, d: Vec3, t: f64) -> Vec3 {
+    [a[0] + d[0] * t, a[1] + d[1] * t, a[2] + d[2] * t]
 }
 
 fn sub(a: Vec3, b: Vec3) -> Vec3 {
@@ -336,6 +469,46 @@ mod tests {
                 .fold(f64::INFINITY, f64::min);
             let got = bvh.hit(&ray, f64::INFINITY).map_or(f64::INFINITY, |h| h.t);
             assert_eq!(got, brute);
+            // The nearest triangle's distance, as by testing every triangle.
+            let brute = bvh
+                .triangles
+                .iter()
+                .map(|t| triangle_distance2(origin, t))
+                .fold(f64::INFINITY, f64::min)
+                .sqrt();
+            assert!((bvh.distance(origin, f64::INFINITY) - brute).abs() < 1e-12);
+            assert_eq!(bvh.distance(origin, 0.5 * brute), 0.5 * brute);
         }
+    }
+
+    /// The distance to a triangle at points over its face, beyond its edges and its corners,
+    /// against closed forms; and the inside of a closed box.
+    #[test]
+    fn distances_and_inside() {
+        let t = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
+        let d = |p: Vec3| triangle_distance2(p, &t).sqrt();
+        assert!((d([1.0, 1.0, 3.0]) - 3.0).abs() < 1e-12);
+        assert!((d([-3.0, -4.0, 0.0]) - 5.0).abs() < 1e-12);
+        assert!((d([2.0, -2.0, 0.0]) - 2.0).abs() < 1e-12);
+        assert!((d([3.0, 3.0, 0.0]) - 2.0f64.sqrt()).abs() < 1e-12);
+        let corners = |i: usize| [i & 1, (i >> 1) & 1, (i >> 2) & 1].map(|b| 10.0 * b as f32);
+        let mut mesh = Mesh::default();
+        for i in 0..8 {
+            mesh.positions.extend(corners(i));
+        }
+        for q in [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ] {
+            mesh.indices.extend([q[0], q[1], q[2], q[0], q[2], q[3]]);
+        }
+        let bvh = Bvh::new(&mesh);
+        assert!(bvh.contains([5.0, 5.0, 5.0]) && bvh.contains([0.1, 9.9, 5.0]));
+        assert!(!bvh.contains([11.0, 5.0, 5.0]) && !bvh.contains([-0.1, 5.0, 5.0]));
+        assert!((bvh.distance([5.0, 5.0, 4.0], 100.0) - 4.0).abs() < 1e-12);
     }
 }

@@ -32,11 +32,11 @@ pub struct Model {
 }
 
 impl Model {
-    /// The distance up to which a strut field is exact (its value is capped there): a quarter
-    /// of a cell, so that the augmented cell holds few struts and a step in empty space still
-    /// crosses a good part of a cell.
+    /// The distance up to which a strut field is exact (its value is capped there): 0.15 of a
+    /// cell, so that the augmented cell holds few struts and a step in empty space still
+    /// crosses a good part of a cell (the fastest of 0.1–0.4 on BCC and filled parts).
     pub fn reach(&self) -> f64 {
-        0.25 * self.cell
+        0.15 * self.cell
     }
 
     /// The solid's field, unclipped.

@@ -4,7 +4,7 @@
 //! radius the surface does not enter, so the ray may advance by it without passing through
 //! anything. Steps are never shorter than a tolerance (a quarter of the pixel at that
 //! distance), so a ray near the surface crosses it within a step or grazes past; a crossing
-//! (the value turning negative) is bisected, so a hit is where the ray enters the solid, not
+//! (the value turning negative) is refined by false position, so a hit is where the ray enters the solid, not
 //! merely where it came close. The clearance of
 //! every latvox field is a true lower bound on the distance — for a TPMS the implicit over its
 //! Lipschitz bound, for a strut lattice the distance to the struts of the augmented cell (every
@@ -53,6 +53,121 @@ pub trait Scene: Sync {
     }
 }
 
+/// The first distance in `(t0, t1)` along `ray` at which a solid — `field(p)` its value and
+/// clearance — is met, by sphere tracing from `t0` (a hit at `t0` where it starts inside).
+pub fn sphere_trace(
+    field: impl Fn(Vec3) -> (f64, f64),
+    ray: &Ray,
+    t0: f64,
+    t1: f64,
+    tol: Tolerance,
+) -> Option<f64> {
+    let mut t = t0;
+    let mut before = (t0, f64::NAN);
+    for _ in 0..MAX_STEPS {
+        if t > t1 {
+            return None;
+        }
+        let (v, c) = field(ray.at(t));
+        if v <= 0.0 {
+            if t == t0 {
+                return Some(t);
+            }
+            return Some(refine(|p| field(p).0, ray, before, (t, v)));
+        }
+        // Steps never shorter than the tolerance: a ray that comes that close to the surface
+        // crosses it within a step (and the crossing is refined) or grazes past; only
+        // something thinner than the tolerance can be stepped over.
+        let eps = tol.absolute + tol.per_distance * t;
+        before = (t, v);
+        t += c.max(eps);
+    }
+    None
+}
+
+/// The crossing between `out` (outside, its value) and `inside`: a step of at most the
+/// tolerance (a longer one cannot cross the surface), narrowed by three steps of false
+/// position.
+fn refine(
+    value: impl Fn(Vec3) -> f64,
+    ray: &Ray,
+    mut out: (f64, f64),
+    mut inside: (f64, f64),
+) -> f64 {
+    let weight = |a: f64, b: f64| {
+        if a.is_finite() && a > b {
+            a / (a - b)
+        } else {
+            0.5
+        }
+    };
+    for _ in 0..3 {
+        let w = weight(out.1, inside.1).clamp(0.05, 0.95);
+        let m = out.0 + w * (inside.0 - out.0);
+        let v = value(ray.at(m));
+        if v <= 0.0 {
+            inside = (m, v);
+        } else {
+            out = (m, v);
+        }
+    }
+    out.0 + weight(out.1, inside.1) * (inside.0 - out.0)
+}
+
+/// The outward unit normal of the zero set of `value` at `p`: its gradient from four samples at
+/// the corners of a tetrahedron of size `h` (their weighted sum is the central difference along
+/// each axis).
+pub fn field_normal(value: impl Fn(Vec3) -> f64, p: Vec3, h: f64) -> Vec3 {
+    let mut g = [0.0; 3];
+    for k in [
+        [1.0, -1.0, -1.0],
+        [-1.0, -1.0, 1.0],
+        [-1.0, 1.0, -1.0],
+        [1.0, 1.0, 1.0],
+    ] {
+        let v = value([p[0] + h * k[0], p[1] + h * k[1], p[2] + h * k[2]]);
+        g = [0, 1, 2].map(|a| g[a] + k[a] * v);
+    }
+    let n = dot(g, g).sqrt();
+    if n > 0.0 {
+        g.map(|x| x / n)
+    } else {
+        [0.0, 0.0, 1.0]
+    }
+}
+
+/// Ambient occlusion from a field (Quilez's five samples along the normal `n`, out to `reach`
+/// mm): 1 where nothing near occludes `p`.
+pub fn field_openness(value: impl Fn(Vec3) -> f64, p: Vec3, n: Vec3, reach: f64) -> f64 {
+    let mut occ = 0.0;
+    let mut weight = 1.0;
+    for k in 1..=5 {
+        let h = 0.2 * reach * k as f64;
+        let q = [0, 1, 2].map(|a| p[a] + h * n[a]);
+        occ += weight * (h - value(q)).max(0.0) / h;
+        weight *= 0.6;
+    }
+    (1.0 - 0.45 * occ).clamp(0.0, 1.0)
+}
+
+/// The nearest triangle of `bvh` along `ray` on `(t0, t1)`, its normal turned to face the ray.
+pub fn mesh_hit(bvh: &Bvh, ray: &Ray, t0: f64, t1: f64) -> Option<Hit> {
+    let start = Ray {
+        origin: ray.at(t0),
+        dir: ray.dir,
+    };
+    let h = bvh.hit(&start, t1 - t0)?;
+    Some(Hit {
+        t: t0 + h.t,
+        normal: if dot(h.normal, ray.dir) > 0.0 {
+            h.normal.map(|x| -x)
+        } else {
+            h.normal
+        },
+        cap: false,
+    })
+}
+
 /// A half-space `normal · p ≤ offset`: what a section keeps.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Section {
@@ -69,7 +184,7 @@ impl Section {
     }
 
     /// The part of `(t0, t1)` along the ray on the side kept, if any.
-    fn keep(&self, ray: &Ray, t0: f64, t1: f64) -> Option<(f64, f64)> {
+    pub fn keep(&self, ray: &Ray, t0: f64, t1: f64) -> Option<(f64, f64)> {
         let d0 = self.distance(ray.origin);
         let rate = dot(self.normal, ray.dir);
         if rate.abs() < 1e-300 {
@@ -145,57 +260,12 @@ impl<'a> Implicit<'a> {
             Some(s) => s.keep(ray, t0, t1)?,
             None => (t0, t1),
         };
-        let mut t = t0;
-        let mut before = t0;
-        for _ in 0..MAX_STEPS {
-            if t > t1 {
-                return None;
-            }
-            let (v, c) = self.value_and_clearance(ray.at(t));
-            if v <= 0.0 {
-                if t == t0 {
-                    return Some(t);
-                }
-                return Some(self.bisect(ray, before, t));
-            }
-            // Steps never shorter than the tolerance: a ray that comes that close to the
-            // surface crosses it within a step (and the crossing is bisected) or grazes past;
-            // only something thinner than the tolerance can be stepped over.
-            let eps = tol.absolute + tol.per_distance * t;
-            before = t;
-            t += c.max(eps);
-        }
-        None
-    }
-
-    /// The crossing between `out` (outside) and `inside`, to a thousandth of the gap.
-    fn bisect(&self, ray: &Ray, mut out: f64, mut inside: f64) -> f64 {
-        for _ in 0..12 {
-            let m = 0.5 * (out + inside);
-            if self.value(ray.at(m)) <= 0.0 {
-                inside = m;
-            } else {
-                out = m;
-            }
-        }
-        0.5 * (out + inside)
+        sphere_trace(|p| self.value_and_clearance(p), ray, t0, t1, tol)
     }
 
     /// The outward unit normal at `p`, from the clipped field's gradient.
     pub fn normal(&self, p: Vec3) -> Vec3 {
-        let h = self.step;
-        let g = [0, 1, 2].map(|a| {
-            let (mut up, mut dn) = (p, p);
-            up[a] += h;
-            dn[a] -= h;
-            self.value(up) - self.value(dn)
-        });
-        let n = dot(g, g).sqrt();
-        if n > 0.0 {
-            g.map(|x| x / n)
-        } else {
-            [0.0, 0.0, 1.0]
-        }
+        field_normal(|q| self.value(q), p, self.step)
     }
 }
 
@@ -219,17 +289,9 @@ impl Scene for Implicit<'_> {
         self.bounds
     }
 
-    /// Ambient occlusion from the field (Quilez's five samples along the normal).
+    /// Ambient occlusion from the field.
     fn openness(&self, p: Vec3, n: Vec3) -> f64 {
-        let mut occ = 0.0;
-        let mut weight = 1.0;
-        for k in 1..=5 {
-            let h = 0.2 * self.reach * k as f64;
-            let q = [0, 1, 2].map(|a| p[a] + h * n[a]);
-            occ += weight * (h - self.value(q)).max(0.0) / h;
-            weight *= 0.6;
-        }
-        (1.0 - 0.45 * occ).clamp(0.0, 1.0)
+        field_openness(|q| self.value(q), p, n, self.reach)
     }
 }
 
@@ -250,21 +312,7 @@ impl Scene for Triangles<'_> {
             Some(s) => s.keep(ray, t0, t1)?,
             None => (t0, t1),
         };
-        let start = Ray {
-            origin: ray.at(t0),
-            dir: ray.dir,
-        };
-        let h = self.bvh.hit(&start, t1 - t0)?;
-        let normal = if dot(h.normal, ray.dir) > 0.0 {
-            h.normal.map(|x| -x)
-        } else {
-            h.normal
-        };
-        Some(Hit {
-            t: t0 + h.t,
-            normal,
-            cap: false,
-        })
+        mesh_hit(self.bvh, ray, t0, t1)
     }
 
     fn bounds(&self) -> Aabb {

@@ -1,0 +1,294 @@
+//! A filled part traced from its meshes, with no distance grid: the augmented sphere tracing of
+//! shell-lattices (Guo and Li, Computer-Aided Design 184, 2025). The part's surface and the
+//! solids kept whole are triangle meshes under BVHs; a ray is cast at them to find where it
+//! enters the part (or a kept solid), and only inside the part is the lattice sphere-traced,
+//! joined to the skin by the distance to the part's surface — asked of the BVH only where it can
+//! matter (within the skin, the blend and the lattice field's reach of the surface), and capped
+//! there. Memory is the meshes' and one unit cell's, whatever the number of cells; nothing is
+//! sampled on voxels.
+
+use super::job::{closed, FillJob, Infilling};
+use super::shape::{skin_or_lattice, Drain};
+use crate::error::Result;
+use crate::field::{intersection_clearance, Aabb, Field, Vec3};
+use crate::grid::GridSpec;
+use crate::mesh::pipeline::Solid;
+use crate::render::bvh::Bvh;
+use crate::render::camera::{dot, Ray};
+use crate::render::trace::{
+    field_normal, field_openness, mesh_hit, sphere_trace, Hit, Scene, Section, Tolerance,
+};
+use crate::strut::{RadiusModel, StrutLattice};
+use crate::tpms::{calibrate, Lattice};
+
+/// A filled part as meshes and a lattice, ready to trace.
+pub struct Traced {
+    part: Bvh,
+    keep: Vec<Bvh>,
+    drains: Vec<Drain>,
+    skin: f64,
+    blend: f64,
+    lattice: Box<dyn Solid + Send>,
+    /// The box of the part and the kept solids.
+    pub bounds: Aabb,
+    /// The voxel meshing would use, mm.
+    pub voxel: f64,
+    /// The shortest cell side, mm.
+    pub cell: f64,
+}
+
+impl FillJob {
+    /// The filled part for tracing: the part's and the kept solids' meshes (closed first, as
+    /// for meshing) and the lattice at the level (or radius) its model gives for the density.
+    pub fn traced(&self) -> Result<Traced> {
+        let (part, _) = closed(&self.part, &self.part_name)?;
+        let keep = self
+            .keep
+            .iter()
+            .map(|(name, m)| closed(m, name).map(|(m, _)| Bvh::new(&m)))
+            .collect::<Result<Vec<_>>>()?;
+        let voxel = self.min_cell() / self.resolution as f64;
+        let drains = match (self.drain, self.skin > 0.0) {
+            (Some(d), true) => {
+                self.check_drain(&part, d)?;
+                Drain::at_ends(&part, d, self.skin + self.blend + voxel)
+            }
+            _ => Vec::new(),
+        };
+        let part = Bvh::new(&part);
+        let mut bounds = part.bounds().expect("a closed part has triangles");
+        for k in &keep {
+            let b = k.bounds().expect("a kept solid has triangles");
+            bounds.min = [0, 1, 2].map(|a| bounds.min[a].min(b.min[a]));
+            bounds.max = [0, 1, 2].map(|a| bounds.max[a].max(b.max[a]));
+        }
+        let lattice: Box<dyn Solid + Send> = match &self.lattice {
+            Infilling::Tpms { surface, structure } => Box::new(Lattice {
+                surface: *surface,
+                structure: *structure,
+                level: calibrate::analytic_level(*surface, *structure, self.density),
+                cell: self.cell,
+                bounds,
+                phase: bounds.min,
+            }),
+            Infilling::Strut { cell } => Box::new(StrutLattice {
+                cell: cell.clone(),
+                size: self.cell,
+                radius: RadiusModel::new(cell, self.cell).radius(self.density),
+                blend: self.blend,
+                bounds,
+                phase: bounds.min,
+            }),
+        };
+        Ok(Traced {
+            part,
+            keep,
+            drains,
+            skin: self.skin,
+            blend: self.blend,
+            lattice,
+            bounds,
+            voxel,
+            cell: self.min_cell(),
+        })
+    }
+}
+
+impl Traced {
+    /// The distance up to which the lattice's field is exact (see [`crate::render::Model`]).
+    fn reach(&self) -> f64 {
+        0.15 * self.cell
+    }
+
+    /// The lattice's field, unclipped, exact up to the reach.
+    pub fn lattice_field(&self) -> Box<dyn Field + '_> {
+        let spec = GridSpec::covering(
+            &self.bounds,
+            self.voxel,
+            (self.reach() / self.voxel).max(1.0),
+        );
+        self.lattice.field(&spec)
+    }
+
+    /// The scene to render, its lattice read from `field` (from [`Traced::lattice_field`]).
+    pub fn scene<'a>(&'a self, field: &'a dyn Field, section: Option<Section>) -> FilledScene<'a> {
+        FilledScene {
+            traced: self,
+            lattice: field,
+            section,
+        }
+    }
+}
+
+/// A filled part, cut by a section plane where asked.
+pub struct FilledScene<'a> {
+    traced: &'a Traced,
+    lattice: &'a dyn Field,
+    section: Option<Section>,
+}
+
+/// A small step past a surface a ray was cast to, mm (relative to the part's size).
+fn nudge(b: &Aabb) -> f64 {
+    1e-7 * (1.0 + b.size().iter().cloned().fold(0.0, f64::max))
+}
+
+impl FilledScene<'_> {
+    /// The distance to the part's surface from a point inside it, capped where the skin and
+    /// the lattice no longer depend on it.
+    fn depth(&self, x: Vec3) -> f64 {
+        let t = self.traced;
+        let cap = t.skin + t.blend + t.reach() + t.voxel;
+        t.part.distance(x, cap)
+    }
+
+    /// The solid inside the part at `x` (the skin or the lattice, less the drain holes): value
+    /// and clearance.
+    fn inside(&self, x: Vec3) -> (f64, f64) {
+        let t = self.traced;
+        let d = self.depth(x);
+        let core = d - t.skin;
+        let (v, c) = skin_or_lattice(
+            (core, core.abs()),
+            self.lattice.value_and_clearance(x),
+            t.skin,
+            t.blend,
+        );
+        t.drains.iter().fold((v, c), |(v, c), h| {
+            let dh = -h.distance(x);
+            (v.max(dh), intersection_clearance(v, c, dh, dh.abs()))
+        })
+    }
+
+    /// The first hit of the solid inside the part along `ray` on `(t0, t1)`, where the ray is
+    /// inside the part throughout.
+    fn trace_inside(&self, ray: &Ray, t0: f64, t1: f64, tol: Tolerance) -> Option<f64> {
+        sphere_trace(|p| self.inside(p), ray, t0, t1, tol)
+    }
+
+    /// The nearest hit of the filled part (without the kept solids) on `(t0, t1)`.
+    fn part_hit(&self, ray: &Ray, t0: f64, t1: f64, tol: Tolerance) -> Option<Hit> {
+        let part = &self.traced.part;
+        let eps = nudge(&self.traced.bounds);
+        let mut t = t0;
+        let mut inside = part.contains(ray.at(t0));
+        while t < t1 {
+            let mut surface = None;
+            if !inside {
+                let from = Ray {
+                    origin: ray.at(t),
+                    dir: ray.dir,
+                };
+                let h = part.hit(&from, t1 - t)?;
+                t += h.t;
+                surface = Some(h.normal);
+            }
+            let exit = part
+                .hit(
+                    &Ray {
+                        origin: ray.at(t + eps),
+                        dir: ray.dir,
+                    },
+                    t1 - t,
+                )
+                .map_or(t1, |h| t + eps + h.t);
+            if let Some(th) = self.trace_inside(ray, t, exit, tol) {
+                let p = ray.at(th);
+                let normal = match (th == t, surface) {
+                    (true, Some(n)) => {
+                        if dot(n, ray.dir) > 0.0 {
+                            n.map(|x| -x)
+                        } else {
+                            n
+                        }
+                    }
+                    (true, None) => match self.cut_at(p) {
+                        Some(normal) => {
+                            return Some(Hit {
+                                t: th,
+                                normal,
+                                cap: true,
+                            })
+                        }
+                        None => self.normal(p),
+                    },
+                    _ => self.normal(p),
+                };
+                return Some(Hit {
+                    t: th,
+                    normal,
+                    cap: false,
+                });
+            }
+            // Out of the part (through a drain hole, or at the end of the ray's span).
+            t = exit + eps;
+            inside = false;
+        }
+        None
+    }
+
+    /// The section plane's normal, if `p` lies on it (where a ray starts on the cut).
+    fn cut_at(&self, p: Vec3) -> Option<Vec3> {
+        let eps = 1e-6 * self.traced.cell;
+        self.section
+            .filter(|s| s.distance(p).abs() <= eps)
+            .map(|s| s.normal)
+    }
+
+    /// The outward normal of the solid inside the part at `p`.
+    fn normal(&self, p: Vec3) -> Vec3 {
+        field_normal(|q| self.inside(q).0, p, 0.1 * self.traced.voxel)
+    }
+}
+
+impl Scene for FilledScene<'_> {
+    fn hit(&self, ray: &Ray, tol: Tolerance) -> Option<Hit> {
+        let b = self.traced.bounds.grown(nudge(&self.traced.bounds));
+        let (t0, t1) = ray.clip(&b)?;
+        let (t0, t1) = match &self.section {
+            Some(s) => s.keep(ray, t0, t1)?,
+            None => (t0, t1),
+        };
+        let mut best: Option<Hit> = None;
+        for k in &self.traced.keep {
+            let start = ray.at(t0);
+            let hit = if let Some(normal) = self.cut_at(start).filter(|_| k.contains(start)) {
+                Some(Hit {
+                    t: t0,
+                    normal,
+                    cap: true,
+                })
+            } else {
+                mesh_hit(k, ray, t0, t1)
+            };
+            if let Some(h) = hit {
+                if best.is_none_or(|b| h.t < b.t) {
+                    best = Some(h);
+                }
+            }
+        }
+        let limit = best.map_or(t1, |h| h.t);
+        match self.part_hit(ray, t0, limit, tol) {
+            Some(h) if best.is_none_or(|b| h.t < b.t) => Some(h),
+            _ => best,
+        }
+    }
+
+    fn bounds(&self) -> Aabb {
+        self.traced.bounds
+    }
+
+    /// Ambient occlusion from the solid inside the part (five samples along the normal; none
+    /// on the part's outer surface).
+    fn openness(&self, p: Vec3, n: Vec3) -> f64 {
+        if self.depth(p) < 0.5 * self.traced.voxel {
+            return 1.0;
+        }
+        let cut = |q: Vec3| self.section.map_or(f64::NEG_INFINITY, |s| s.distance(q));
+        field_openness(
+            |q| self.inside(q).0.max(cut(q)),
+            p,
+            n,
+            self.traced.cell / 6.0,
+        )
+    }
+}
