@@ -485,8 +485,9 @@ fn bad_input_is_refused() {
     std::fs::rename(d.join("torus.stl"), d.join("moved.stl")).unwrap();
     std::fs::write(d.join("junk.toml"), "command = \"paint\"\n").unwrap();
     std::fs::write(d.join("broken.toml"), "command = [\n").unwrap();
+    std::fs::write(d.join("dense.toml"), "command = \"tpms\"\ndensity = 1.5\n").unwrap();
     let before = files_in(d);
-    let cases: [(&[&str], &str); 8] = [
+    let cases: [(&[&str], &str); 10] = [
         (
             &["render", "f.stl", "--view", "sideways", "-o", "x.png"],
             "sideways",
@@ -501,9 +502,59 @@ fn bad_input_is_refused() {
             &["render", "f.stl", "--section", "w=3", "-o", "x.png"],
             "section",
         ),
+        (
+            &["render", "dense.toml", "-o", "x.png"],
+            "dense.toml: invalid value '1.5'",
+        ),
+        (
+            &[
+                "render", "f.stl", "--width", "12000", "--height", "9000", "-o", "x.png",
+            ],
+            "million pixels",
+        ),
     ];
     for (args, what) in cases {
         let out = run(args, d);
         assert_refusal(d, &before, &out, args, what);
+    }
+}
+
+/// README's pictures are what `latvox render` makes of the part files beside them, run from
+/// another folder (a part file names its mesh relative to itself): the same picture at ≥ 99 %
+/// of pixels (within 8 levels per channel).
+#[test]
+fn readme_pictures_are_what_render_makes() {
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs");
+    let dir = tempdir();
+    let d = dir.path();
+    let size = ["--width", "400", "--height", "300"];
+    let cases: [(&str, &[&str]); 3] = [
+        ("gyroid", &[]),
+        ("octet", &[]),
+        (
+            "filled",
+            &["--section", "z=2", "--distance", "70", "--elevation", "40"],
+        ),
+    ];
+    for (name, extra) in cases {
+        let part = docs.join(format!("{name}.toml"));
+        let part = part.to_str().unwrap();
+        let mut args = vec!["render", part, "-o", "new.png"];
+        args.extend_from_slice(&size);
+        args.extend_from_slice(extra);
+        ok(&args, d);
+        let (w, h, new) = read_png(&d.join("new.png"));
+        let (w0, h0, old) = read_png(&docs.join(format!("{name}.png")));
+        assert_eq!((w, h), (w0, h0));
+        let same = new
+            .chunks(3)
+            .zip(old.chunks(3))
+            .filter(|(a, b)| a.iter().zip(b.iter()).all(|(x, y)| x.abs_diff(*y) <= 8))
+            .count();
+        assert!(
+            same * 100 >= 99 * (w * h) as usize,
+            "{name}: {same} of {} pixels as in README",
+            w * h
+        );
     }
 }

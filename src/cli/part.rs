@@ -6,8 +6,8 @@
 //! values as on the command line (`cell-size = [5.0, 5.0, 5.0]` is `--cell-size 5,5,5`). Given
 //! with `--part`, its options come first and the command line's override them: an option given
 //! on the command line replaces the file's (and `--radius` replaces the file's `--density`, and
-//! the reverse). Where the file names a cell file by a relative path, it is relative to the
-//! part file.
+//! the reverse). Where the file names a file by a relative path (a cell file, the part filled,
+//! the solids kept), it is relative to the part file.
 
 use latvox::{Error, Result};
 use std::path::Path;
@@ -226,13 +226,17 @@ pub fn expand(command: &str, argv: Vec<String>) -> Result<Vec<String>> {
                 path.display()
             ))
         })?;
-        if key == "cell" && arg.to_ascii_lowercase().ends_with(".json") {
-            let cell = Path::new(&arg);
-            if cell.is_relative() {
-                if let Some(dir) = path.parent() {
-                    arg = dir.join(cell).display().to_string();
-                }
+        // Files the part file names by a relative path are relative to it.
+        let names_file = PATHS.contains(&key.as_str())
+            || (key == "cell" && arg.to_ascii_lowercase().ends_with(".json"));
+        let beside = |file: &str| match path.parent() {
+            Some(dir) if names_file && Path::new(file).is_relative() => {
+                dir.join(file).display().to_string()
             }
+            _ => file.to_string(),
+        };
+        if !matches!(value, toml::Value::Array(_)) {
+            arg = beside(&arg);
         }
         match value {
             // A switch in the file: on when true.
@@ -241,7 +245,10 @@ pub fn expand(command: &str, argv: Vec<String>) -> Result<Vec<String>> {
             // A repeated option: once per item.
             toml::Value::Array(items) if items.iter().all(toml::Value::is_str) => {
                 for item in items {
-                    front.push(format!("--{key}={}", item.as_str().unwrap_or_default()));
+                    front.push(format!(
+                        "--{key}={}",
+                        beside(item.as_str().unwrap_or_default())
+                    ));
                 }
             }
             _ => front.push(format!("--{key}={arg}")),

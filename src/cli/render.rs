@@ -33,6 +33,9 @@ fast as one of a thousand. A mesh file (.stl, .3mf, .obj, .off, .ply) is ray cas
 Angles: the azimuth turns about z from the front (eye on −y, 0°) towards the right (eye on +x,
 90°); the elevation lifts the eye above the xy plane.";
 
+/// The most pixels one picture holds (all views together): some 1.3 GB of colour and depth.
+const MAX_PIXELS: u64 = 100_000_000;
+
 #[derive(Args)]
 pub struct RenderArgs {
     /// A part file (.toml, from --save-part) or a mesh file (.stl, .3mf, .obj, .off, .ply).
@@ -153,7 +156,18 @@ pub(crate) fn part_of(path: &Path) -> Result<Part> {
         .unwrap_or_default()
         .to_string();
     let argv = vec!["--part".to_string(), path.display().to_string()];
-    match command.as_str() {
+    // A setting the part file gives wrongly: said of the part file.
+    let named = |e: Error| match e {
+        Error::Invalid(m) if !m.contains(&path.display().to_string()) => {
+            Error::invalid(format!("{}: {m}", path.display()))
+        }
+        e => e,
+    };
+    part_from(&command, argv, path).map_err(named)
+}
+
+fn part_from(command: &str, argv: Vec<String>, path: &Path) -> Result<Part> {
+    match command {
         "tpms" => Ok(Part::Block(
             parse::<super::tpms::TpmsArgs>("tpms", argv)?
                 .job()?
@@ -202,6 +216,21 @@ pub fn run(a: &RenderArgs) -> Result<i32> {
         return Err(Error::invalid(format!(
             "{}: pictures are written as PNG: name the output .png",
             a.output.display()
+        )));
+    }
+    let n_views = a.turntable.unwrap_or(1) as u64;
+    let pixels = a.width as u64 * a.height as u64 * n_views;
+    if pixels > MAX_PIXELS {
+        return Err(Error::invalid(format!(
+            "{} × {} pixels{} is more than latvox renders at once ({} million pixels)",
+            a.width,
+            a.height,
+            if n_views > 1 {
+                format!(" × {n_views} views")
+            } else {
+                String::new()
+            },
+            MAX_PIXELS / 1_000_000
         )));
     }
     latvox::io::atomic::check_writable(&a.output)?;
