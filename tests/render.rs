@@ -445,6 +445,37 @@ fn sections_and_turntables() {
     );
     let (w, h, _) = read_png(&d.join("turn.png"));
     assert_eq!((w, h), (480, 90));
+    // As an animation: one frame a view, each a picture of its own size.
+    ok(
+        &[
+            "render",
+            "part.toml",
+            "-o",
+            "spin.png",
+            "--turntable",
+            "3",
+            "--animate",
+            "--width",
+            "60",
+            "--height",
+            "40",
+        ],
+        d,
+    );
+    let file = std::fs::File::open(d.join("spin.png")).unwrap();
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .unwrap();
+    let control = reader.info().animation_control.expect("an animated PNG");
+    assert_eq!(control.num_frames, 3);
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let mut frames = Vec::new();
+    while let Ok(info) = reader.next_frame(&mut buf) {
+        assert_eq!((info.width, info.height), (60, 40));
+        frames.push(buf[..info.buffer_size()].to_vec());
+    }
+    assert_eq!(frames.len(), 3);
+    assert_ne!(frames[0], frames[1], "the views turn");
 }
 
 fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {

@@ -21,8 +21,9 @@ Examples:
   # A strut part, 1200×900, from the top, cut at z = 10 mm to show the inside
   latvox render bcc.toml -o bcc.png --view top --width 1200 --height 900 --section z=10
 
-  # Eight views around the part, side by side in one picture
+  # Eight views around the part, side by side in one picture; 36 as an animation (APNG)
   latvox render filled.toml -o turn.png --turntable 8 --width 320 --height 240
+  latvox render filled.toml -o spin.png --turntable 36 --animate --width 400 --height 300
 
   # The meshed part, ray cast, from the same camera (to compare), with its depth as .npy
   latvox render gyroid.stl -o gyroid-mesh.png --depth gyroid-mesh.npy
@@ -69,7 +70,12 @@ pub struct RenderArgs {
     /// N views around the part (the azimuth stepped by 360°/N), side by side in one picture.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=72))]
     pub turntable: Option<u32>,
-    /// Also write the depth per pixel (mm from the eye, inf where the ray missed) as .npy.
+    /// With --turntable: an animated PNG (APNG) of the views, a tenth of a second each, instead
+    /// of a strip.
+    #[arg(long, requires = "turntable")]
+    pub animate: bool,
+    /// Also write the depth per pixel (mm from the eye, inf where the ray missed) as .npy (the
+    /// views side by side, with --turntable).
     #[arg(long, value_name = "FILE.npy")]
     pub depth: Option<PathBuf>,
     /// Print the summary as JSON.
@@ -237,20 +243,20 @@ pub fn run(a: &RenderArgs) -> Result<i32> {
     if let Some(d) = &a.depth {
         latvox::io::atomic::check_writable(d)?;
     }
-    let (frame, method) = if is_part_file(&a.input) {
-        let frame = match part_of(&a.input)? {
+    let (frames, method) = if is_part_file(&a.input) {
+        let frames = match part_of(&a.input)? {
             Part::Block(model) => {
                 let field = model.field();
                 let scene =
                     Implicit::new(&*field, model.bounds(), a.section, model.voxel, model.cell);
-                views(a, &scene)?
+                views(a, &scene)
             }
             Part::Filled(traced) => {
                 let field = traced.lattice_field();
-                views(a, &traced.scene(&*field, a.section))?
+                views(a, &traced.scene(&*field, a.section))
             }
         };
-        (frame, "implicit")
+        (frames, "implicit")
     } else {
         let loaded = latvox::io::read(&a.input, &Default::default())?;
         if loaded.mesh.indices.is_empty() {
@@ -264,9 +270,15 @@ pub fn run(a: &RenderArgs) -> Result<i32> {
             bvh: &bvh,
             section: a.section,
         };
-        (views(a, &scene)?, "mesh")
+        (views(a, &scene), "mesh")
     };
-    frame.write_png(&a.output)?;
+    let frame = Frame::strip(&frames)?;
+    if a.animate {
+        let rgb: Vec<&[u8]> = frames.iter().map(|f| f.rgb.as_slice()).collect();
+        latvox::io::png::write_animated(&a.output, a.width, a.height, &rgb, 100)?;
+    } else {
+        frame.write_png(&a.output)?;
+    }
     if let Some(d) = &a.depth {
         frame.write_depth(d)?;
     }
@@ -305,20 +317,15 @@ pub fn run(a: &RenderArgs) -> Result<i32> {
     Ok(0)
 }
 
-/// The view asked for, or the turntable's views side by side.
-fn views(a: &RenderArgs, scene: &dyn Scene) -> Result<Frame> {
+/// The view asked for, or the turntable's views.
+fn views(a: &RenderArgs, scene: &dyn Scene) -> Vec<Frame> {
     let bounds = scene.bounds();
     let (az0, el0) = a.view.angles();
     let az = a.azimuth.unwrap_or(az0);
     let el = a.elevation.unwrap_or(el0);
     let camera = |az: f64| Camera::looking_at(&bounds, az, el, a.distance, a.width, a.height);
-    match a.turntable {
-        None | Some(1) => Ok(render(scene, &camera(az))),
-        Some(n) => {
-            let frames: Vec<Frame> = (0..n)
-                .map(|i| render(scene, &camera(az + 360.0 * i as f64 / n as f64)))
-                .collect();
-            Frame::strip(&frames)
-        }
-    }
+    let n = a.turntable.unwrap_or(1);
+    (0..n)
+        .map(|i| render(scene, &camera(az + 360.0 * i as f64 / n as f64)))
+        .collect()
 }

@@ -145,7 +145,8 @@ impl FilledScene<'_> {
     /// and clearance.
     fn inside(&self, x: Vec3) -> (f64, f64) {
         let t = self.traced;
-        let d = self.depth(x);
+        // Without a skin the lattice alone fills the part, whatever the depth.
+        let d = if t.skin > 0.0 { self.depth(x) } else { 0.0 };
         let core = d - t.skin;
         let (v, c) = skin_or_lattice(
             (core, core.abs()),

@@ -14,3 +14,28 @@ pub fn write_rgb(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<()>
         wr.finish().map_err(std::io::Error::other)
     })
 }
+
+/// Writes `frames` (each `rgb` as for [`write_rgb`], all `width × height`) as an animated PNG
+/// (APNG) that loops forever, each frame shown `delay_ms` milliseconds; viewers without APNG
+/// show the first frame.
+pub fn write_animated(
+    path: &Path,
+    width: u32,
+    height: u32,
+    frames: &[&[u8]],
+    delay_ms: u16,
+) -> Result<()> {
+    crate::io::atomic::write_atomic(path, |w| {
+        let err = std::io::Error::other;
+        let mut e = ::png::Encoder::new(w, width, height);
+        e.set_color(::png::ColorType::Rgb);
+        e.set_depth(::png::BitDepth::Eight);
+        e.set_animated(frames.len() as u32, 0).map_err(err)?;
+        e.set_frame_delay(delay_ms, 1000).map_err(err)?;
+        let mut wr = e.write_header().map_err(err)?;
+        for f in frames {
+            wr.write_image_data(f).map_err(err)?;
+        }
+        wr.finish().map_err(err)
+    })
+}

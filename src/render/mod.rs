@@ -68,12 +68,14 @@ pub struct Frame {
     pub depth: Vec<f32>,
 }
 
+/// Pixels traced together: a square tile's edge.
 const TILE: u32 = 16;
+/// The part's colour, and the colour of the faces a section cuts.
+const BODY: Vec3 = [0.60, 0.66, 0.76];
+const CAP: Vec3 = [0.86, 0.46, 0.34];
 
 /// A traced pixel: where, its colour and its depth.
 type Pixel = (u32, u32, [u8; 3], f32);
-const BODY: Vec3 = [0.60, 0.66, 0.76];
-const CAP: Vec3 = [0.86, 0.46, 0.34];
 
 /// Renders `scene` through `camera`.
 pub fn render(scene: &dyn Scene, camera: &Camera) -> Frame {

@@ -4,16 +4,15 @@
 //! radius the surface does not enter, so the ray may advance by it without passing through
 //! anything. Steps are never shorter than a tolerance (a quarter of the pixel at that
 //! distance), so a ray near the surface crosses it within a step or grazes past; a crossing
-//! (the value turning negative) is refined by false position, so a hit is where the ray enters the solid, not
-//! merely where it came close. The clearance of
-//! every latvox field is a true lower bound on the distance — for a TPMS the implicit over its
-//! Lipschitz bound, for a strut lattice the distance to the struts of the augmented cell (every
-//! strut of the cell and every copy from the neighbouring cells within the field's reach) capped
-//! at that reach: a strut not in the augmented cell is farther than the reach from any point of
-//! the cell, so the capped per-cell distance is a safe step across cell boundaries as well
-//! (the guarantee a stop on the cell boundary gives in Guo and Li's augmented sphere tracing,
-//! without the extra stop). No step can therefore tunnel through a strut or sheet thicker than
-//! the tolerance.
+//! (the value turning negative) is refined by false position, so a hit is where the ray enters
+//! the solid, not merely where it came close. The clearance of every latvox field is a true
+//! lower bound on the distance — for a TPMS the implicit over its Lipschitz bound, for a strut
+//! lattice the distance to the struts of the augmented cell (every strut of the cell and every
+//! copy from the neighbouring cells within the field's reach) capped at that reach: a strut not
+//! in the augmented cell is farther than the reach from any point of the cell, so the capped
+//! per-cell distance is a safe step across cell boundaries as well (the guarantee a stop on the
+//! cell boundary gives in Guo and Li's augmented sphere tracing, without the extra stop). No
+//! step can therefore tunnel through a strut or sheet thicker than the tolerance.
 
 use super::bvh::Bvh;
 use super::camera::{dot, Ray};
