@@ -166,12 +166,19 @@ impl FilledScene<'_> {
         sphere_trace(|p| self.inside(p), ray, t0, t1, tol)
     }
 
-    /// The nearest hit of the filled part (without the kept solids) on `(t0, t1)`.
-    fn part_hit(&self, ray: &Ray, t0: f64, t1: f64, tol: Tolerance) -> Option<Hit> {
+    /// The nearest hit of the filled part (without the kept solids) on `(t0, t1)`; `outside`:
+    /// the ray is known to start outside the part.
+    fn part_hit(
+        &self,
+        ray: &Ray,
+        (t0, t1): (f64, f64),
+        outside: bool,
+        tol: Tolerance,
+    ) -> Option<Hit> {
         let part = &self.traced.part;
         let eps = nudge(&self.traced.bounds);
         let mut t = t0;
-        let mut inside = part.contains(ray.at(t0));
+        let mut inside = !outside && part.contains(ray.at(t0));
         while t < t1 {
             let mut surface = None;
             if !inside {
@@ -244,11 +251,14 @@ impl FilledScene<'_> {
 impl Scene for FilledScene<'_> {
     fn hit(&self, ray: &Ray, tol: Tolerance) -> Option<Hit> {
         let b = self.traced.bounds.grown(nudge(&self.traced.bounds));
-        let (t0, t1) = ray.clip(&b)?;
+        let (entry, exit) = ray.clip(&b)?;
         let (t0, t1) = match &self.section {
-            Some(s) => s.keep(ray, t0, t1)?,
-            None => (t0, t1),
+            Some(s) => s.keep(ray, entry, exit)?,
+            None => (entry, exit),
         };
+        // A ray that starts on the box (grown past the part), not on the cut nor inside the box
+        // (the camera there), starts outside the part.
+        let outside = t0 == entry && entry > 0.0;
         let mut best: Option<Hit> = None;
         for k in &self.traced.keep {
             let start = ray.at(t0);
@@ -268,7 +278,7 @@ impl Scene for FilledScene<'_> {
             }
         }
         let limit = best.map_or(t1, |h| h.t);
-        match self.part_hit(ray, t0, limit, tol) {
+        match self.part_hit(ray, (t0, limit), outside, tol) {
             Some(h) if best.is_none_or(|b| h.t < b.t) => Some(h),
             _ => best,
         }
