@@ -36,10 +36,11 @@ else
 fi
 
 # Python packages for the tests: NumPy/SciPy (reference optimisers, independent checks of the
-# cleaned fields), gmsh (OpenCASCADE reads the IGES back), ezdxf (reads the DXF back), and
-# trimesh with networkx and lxml (an independent mesh analyser for check/repair).
-PY_PKGS=(numpy scipy gmsh ezdxf trimesh networkx lxml lib3mf)
-PY_IMPORTS="import numpy, scipy, gmsh, ezdxf, trimesh, networkx, lxml, lib3mf"
+# cleaned fields), gmsh (OpenCASCADE reads the IGES back), ezdxf (reads the DXF back),
+# trimesh with networkx and lxml (an independent mesh analyser for check/repair), and shapely
+# (checks every slice layer's polygons).
+PY_PKGS=(numpy scipy gmsh ezdxf trimesh networkx lxml lib3mf shapely)
+PY_IMPORTS="import numpy, scipy, gmsh, ezdxf, trimesh, networkx, lxml, lib3mf, shapely"
 if python3 -c "$PY_IMPORTS" 2>/dev/null; then
   echo "install-deps: Python packages present" >&2
 else

@@ -67,6 +67,7 @@ pub mod mesh;
 pub mod progress;
 pub mod render;
 pub mod repair;
+pub mod slice;
 pub mod strut;
 pub mod topopt;
 pub mod tpms;

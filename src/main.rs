@@ -64,6 +64,10 @@ enum Command {
     /// it, or of a mesh file, ray cast.
     #[command(after_help = cli::render::EXAMPLES)]
     Render(cli::render::RenderArgs),
+    /// Slice a mesh file into layers for printing: CLI (Common Layer Interface), SVG, PNG
+    /// masks, SL1; uniform or adaptive layers, any build direction.
+    #[command(after_help = cli::slice::EXAMPLES)]
+    Slice(cli::slice::SliceArgs),
     /// Run many jobs from a TOML job file: sweeps, workers, resume after a kill, Slurm arrays.
     #[command(after_help = cli::batch::EXAMPLES)]
     Batch(cli::batch::BatchArgs),
@@ -163,6 +167,7 @@ fn main() {
         Command::Topo(a) => cli::topo::run(a, cli.quiet),
         Command::Batch(a) => cli::batch::run(a, cli.quiet),
         Command::Render(a) => cli::render::run(a),
+        Command::Slice(a) => cli::slice::run(a, cli.quiet),
     };
     let result = result.and_then(|code| {
         if let Some((name, path, sub)) = &save_part {

@@ -9,6 +9,7 @@ pub(crate) mod out;
 pub mod part;
 pub mod render;
 pub mod repair;
+pub mod slice;
 pub mod strut;
 pub mod topo;
 pub mod topopt;

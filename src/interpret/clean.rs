@@ -295,7 +295,11 @@ fn raise(
 /// The level near `start` at which the contour of `f` encloses `goal` mm² (secant iteration).
 fn level_for_area(f: &Raster, start: f64, goal: f64) -> f64 {
     use super::contour::{loops, signed_area};
-    secant(|t| loops(f, t).iter().map(signed_area).sum(), start, goal)
+    secant(
+        |t| loops(f, t).iter().map(|l| signed_area(l)).sum(),
+        start,
+        goal,
+    )
 }
 
 /// The level near `start` at which `measure` is `goal` (secant iteration, at most six steps);

@@ -7,20 +7,7 @@
 
 use super::raster::Raster;
 
-/// A closed polyline in mm (first point not repeated at the end).
-pub type Loop = Vec<[f64; 2]>;
-
-/// Signed area (positive counter-clockwise), mm².
-pub fn signed_area(l: &Loop) -> f64 {
-    let n = l.len();
-    (0..n)
-        .map(|i| {
-            let (a, b) = (l[i], l[(i + 1) % n]);
-            a[0] * b[1] - b[0] * a[1]
-        })
-        .sum::<f64>()
-        * 0.5
-}
+pub use crate::slice::contour::{contains, polygons, signed_area, Loop};
 
 /// Loops of `{f ≥ level}`, with the field's pixel `(i, j)` centred at `((i + ½)h, (j + ½)h)`.
 pub fn loops(f: &Raster, level: f64) -> Vec<Loop> {
@@ -107,45 +94,6 @@ pub fn loops(f: &Raster, level: f64) -> Vec<Loop> {
     out
 }
 
-/// Groups loops into polygons: each counter-clockwise loop with the clockwise loops (holes)
-/// directly inside it. Returns `(outer, holes)` index lists.
-pub fn polygons(loops: &[Loop]) -> Vec<(usize, Vec<usize>)> {
-    let areas: Vec<f64> = loops.iter().map(signed_area).collect();
-    let mut polys: Vec<(usize, Vec<usize>)> = (0..loops.len())
-        .filter(|&i| areas[i] > 0.0)
-        .map(|i| (i, Vec::new()))
-        .collect();
-    for h in (0..loops.len()).filter(|&i| areas[i] <= 0.0) {
-        let p = loops[h][0];
-        let parent = polys
-            .iter()
-            .enumerate()
-            .filter(|(_, (o, _))| contains(&loops[*o], p))
-            .min_by(|a, b| areas[a.1 .0].total_cmp(&areas[b.1 .0]))
-            .map(|(k, _)| k);
-        if let Some(k) = parent {
-            polys[k].1.push(h);
-        }
-    }
-    polys
-}
-
-/// Even–odd point-in-polygon test.
-pub fn contains(l: &Loop, p: [f64; 2]) -> bool {
-    let mut inside = false;
-    let n = l.len();
-    for i in 0..n {
-        let (a, b) = (l[i], l[(i + 1) % n]);
-        if (a[1] > p[1]) != (b[1] > p[1]) {
-            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
-            if p[0] < x {
-                inside = !inside;
-            }
-        }
-    }
-    inside
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -169,8 +117,8 @@ mod tests {
         assert_eq!(ls.len(), 2);
         let polys = polygons(&ls);
         assert_eq!(polys.len(), 1);
-        assert_eq!(polys[0].1.len(), 1);
-        let area: f64 = ls.iter().map(signed_area).sum();
+        assert_eq!(polys[0].holes.len(), 1);
+        let area: f64 = ls.iter().map(|l| signed_area(l)).sum();
         let exact = std::f64::consts::PI * (15.0f64.powi(2) - 8.0f64.powi(2)) * 0.25;
         assert!((area - exact).abs() / exact < 0.03, "{area} vs {exact}");
     }

@@ -61,7 +61,7 @@ pub fn extrude(loops: &[Loop], thickness: f64) -> Result<Mesh> {
     let mut ec = earcut::Earcut::new();
     let mut refiner = earcut::Refiner::new();
     let mut tris: Vec<u32> = Vec::new();
-    for (outer, holes) in polygons(loops) {
+    for crate::slice::contour::Polygon { outer, holes } in polygons(loops) {
         let mut data: Vec<[f64; 2]> = loops[outer].clone();
         let mut map: Vec<u32> = (0..loops[outer].len())
             .map(|k| (starts[outer] + k) as u32)

@@ -341,7 +341,7 @@ fn report(
     let final_measure = if d.is_3d {
         checks.volume.unwrap_or(f64::NAN)
     } else {
-        loops.iter().map(contour::signed_area).sum()
+        loops.iter().map(|l| contour::signed_area(l)).sum()
     };
     let (uc, ac): (usize, usize) = (
         fits.iter().map(|f| f.uniform_control_points).sum(),

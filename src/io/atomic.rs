@@ -146,3 +146,114 @@ pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
         w.write_all(b"\n")
     })
 }
+
+/// A file written in pieces and put in place whole: a temporary beside the target until
+/// [`AtomicFile::commit`]; dropped uncommitted, it leaves nothing.
+pub struct AtomicFile {
+    path: std::path::PathBuf,
+    w: BufWriter<tempfile::NamedTempFile>,
+}
+
+impl AtomicFile {
+    /// Starts writing `path`.
+    pub fn create(path: &Path) -> Result<AtomicFile> {
+        Ok(AtomicFile {
+            path: path.to_path_buf(),
+            w: BufWriter::with_capacity(1 << 20, temp_beside(path)?),
+        })
+    }
+
+    /// The target's path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Writes `bytes`.
+    pub fn write(&mut self, bytes: &[u8]) -> Result<()> {
+        self.w
+            .write_all(bytes)
+            .map_err(|e| Error::io(&self.path, e))
+    }
+
+    /// The writer, for formatted output; errors map with [`AtomicFile::error`].
+    pub fn writer(&mut self) -> &mut dyn Write {
+        &mut self.w
+    }
+
+    /// An I/O error of this file, naming the target.
+    pub fn error(&self, e: std::io::Error) -> Error {
+        Error::io(&self.path, e)
+    }
+
+    /// Flushes, syncs and renames over the target.
+    pub fn commit(self) -> Result<()> {
+        let path = self.path;
+        let tmp = self
+            .w
+            .into_inner()
+            .map_err(|e| Error::io(&path, e.into_error()))?;
+        tmp.as_file().sync_data().map_err(|e| Error::io(&path, e))?;
+        tmp.persist(&path).map_err(|e| Error::io(&path, e.error))?;
+        Ok(())
+    }
+}
+
+/// A folder filled file by file and put in place whole: a temporary folder beside the target
+/// until [`AtomicDir::commit`], which replaces the target folder (and what it held).
+pub struct AtomicDir {
+    path: std::path::PathBuf,
+    tmp: tempfile::TempDir,
+}
+
+impl AtomicDir {
+    /// Starts filling the folder `path` (its parent must exist; `path` itself may exist, as a
+    /// folder, and is replaced on commit).
+    pub fn create(path: &Path) -> Result<AtomicDir> {
+        if path.exists() && !path.is_dir() {
+            return Err(Error::invalid(format!(
+                "{}: exists and is not a folder",
+                path.display()
+            )));
+        }
+        let tmp = tempfile::Builder::new()
+            .prefix(&temp_prefix(path))
+            .rand_bytes(RANDOM_LEN)
+            .tempdir_in(parent_dir(path))
+            .map_err(|e| folder_error(path, e))?;
+        Ok(AtomicDir {
+            path: path.to_path_buf(),
+            tmp,
+        })
+    }
+
+    /// Where a file named `name` is written before the commit.
+    pub fn file(&self, name: &str) -> std::path::PathBuf {
+        self.tmp.path().join(name)
+    }
+
+    /// Puts the folder in place, replacing an existing one.
+    pub fn commit(self) -> Result<()> {
+        let err = |e| Error::io(&self.path, e);
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            std::fs::set_permissions(self.tmp.path(), std::fs::Permissions::from_mode(0o755))
+                .map_err(err)?;
+        }
+        let old = if self.path.exists() {
+            let old = tempfile::Builder::new()
+                .prefix(&temp_prefix(&self.path))
+                .tempdir_in(parent_dir(&self.path))
+                .map_err(err)?;
+            let aside = old.path().join("old");
+            std::fs::rename(&self.path, &aside).map_err(err)?;
+            Some(old)
+        } else {
+            None
+        };
+        let tmp = self.tmp.keep();
+        std::fs::rename(&tmp, &self.path).map_err(err)?;
+        drop(old);
+        Ok(())
+    }
+}

@@ -39,3 +39,21 @@ pub fn write_animated(
         wr.finish().map_err(err)
     })
 }
+
+/// `grey` (row by row from the top, a byte a pixel) as an 8-bit greyscale PNG, in memory.
+pub fn encode_grey(width: u32, height: u32, grey: &[u8]) -> Result<Vec<u8>> {
+    let mut out = Vec::new();
+    {
+        let mut e = ::png::Encoder::new(&mut out, width, height);
+        e.set_color(::png::ColorType::Grayscale);
+        e.set_depth(::png::BitDepth::Eight);
+        e.set_compression(::png::Compression::Fast);
+        let err = |e: ::png::EncodingError| {
+            crate::error::Error::io(Path::new("PNG"), std::io::Error::other(e))
+        };
+        let mut wr = e.write_header().map_err(err)?;
+        wr.write_image_data(grey).map_err(err)?;
+        wr.finish().map_err(err)?;
+    }
+    Ok(out)
+}

@@ -28,6 +28,28 @@ pub struct EdgeStats {
 }
 
 impl Mesh {
+    /// The axis-aligned box `lo..hi`: 8 vertices, 12 facets wound outward.
+    pub fn cuboid(lo: [f32; 3], hi: [f32; 3]) -> Mesh {
+        let mut positions = Vec::with_capacity(24);
+        for i in 0..8 {
+            for (a, (l, h)) in lo.iter().zip(hi).enumerate() {
+                positions.push(if i >> a & 1 == 1 { h } else { *l });
+            }
+        }
+        let mut indices = Vec::with_capacity(36);
+        for q in [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ] {
+            indices.extend([q[0], q[1], q[2], q[0], q[2], q[3]]);
+        }
+        Mesh { positions, indices }
+    }
+
     /// Number of vertices.
     pub fn vertex_count(&self) -> usize {
         self.positions.len() / 3

@@ -491,21 +491,7 @@ mod tests {
         assert!((d([-3.0, -4.0, 0.0]) - 5.0).abs() < 1e-12);
         assert!((d([2.0, -2.0, 0.0]) - 2.0).abs() < 1e-12);
         assert!((d([3.0, 3.0, 0.0]) - 2.0f64.sqrt()).abs() < 1e-12);
-        let corners = |i: usize| [i & 1, (i >> 1) & 1, (i >> 2) & 1].map(|b| 10.0 * b as f32);
-        let mut mesh = Mesh::default();
-        for i in 0..8 {
-            mesh.positions.extend(corners(i));
-        }
-        for q in [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ] {
-            mesh.indices.extend([q[0], q[1], q[2], q[0], q[2], q[3]]);
-        }
+        let mesh = Mesh::cuboid([0.0; 3], [10.0; 3]);
         let bvh = Bvh::new(&mesh);
         assert!(bvh.contains([5.0, 5.0, 5.0]) && bvh.contains([0.1, 9.9, 5.0]));
         assert!(!bvh.contains([11.0, 5.0, 5.0]) && !bvh.contains([-0.1, 5.0, 5.0]));

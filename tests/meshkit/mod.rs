@@ -344,12 +344,13 @@ pub fn intersecting_pairs(tris: &[Tri]) -> usize {
     n
 }
 
-/// A torus of radii `big` and `small` about the z axis, `nu × nv` quads, wound outward.
+/// A torus of radii `big` and `small` about the z axis, `nu × nv` planar quads, wound outward;
+/// the seams share their vertices exactly (indices wrap, angles are never recomputed at 2π).
 pub fn torus(big: f64, small: f64, nu: usize, nv: usize) -> Vec<Tri> {
     let p = |i: usize, j: usize| {
         let (u, v) = (
-            2.0 * std::f64::consts::PI * i as f64 / nu as f64,
-            2.0 * std::f64::consts::PI * j as f64 / nv as f64,
+            2.0 * std::f64::consts::PI * (i % nu) as f64 / nu as f64,
+            2.0 * std::f64::consts::PI * (j % nv) as f64 / nv as f64,
         );
         let r = big + small * v.cos();
         [r * u.cos(), r * u.sin(), small * v.sin()]

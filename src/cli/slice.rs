@@ -1,0 +1,234 @@
+//! `latvox slice`: a mesh file cut into layers — CLI, SVG, PNG masks, SL1 — with a per-layer
+//! table.
+
+use super::out::outln;
+use clap::{Args, ValueEnum};
+use latvox::check::CheckOptions;
+use latvox::slice::job::{slice_file, FolderFormat, Output, SliceOptions, SliceReport};
+use latvox::slice::plan::Rule;
+use latvox::Result;
+use std::path::PathBuf;
+
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  latvox slice part.stl -o part.cli --layer 0.05             # Common Layer Interface, ASCII
+  latvox slice part.stl -o part.cli --binary --csv part.csv  # binary CLI and a per-layer table
+  latvox slice part.3mf -o layers/ --pixel 0.05              # PNG masks for DLP/SLA + stack.json
+  latvox slice part.stl -o part.sl1 --layer 0.05             # PrusaSlicer SL1 archive
+  latvox slice part.stl -o part.svg --direction 0,1,1        # SVG stack, tilted build
+  latvox slice part.stl --csv p.csv --adaptive area --c 0.1 --min-layer 0.025 --max-layer 0.2
+  latvox slice part.stl --csv p.csv --adaptive cusp --cusp 0.01
+  latvox slice scan.stl -o scan.cli --repair                 # mend an open mesh in memory first
+  latvox slice big.stl -o layers/ --shard 3/8                # one task of a Slurm array
+
+The mesh is checked first: one that is not a closed, outward solid (holes, non-manifold or
+inconsistently wound edges, inward shells, T-junctions) is refused with what was found, unless
+--repair mends it in memory. Layers are cut at their mid-heights along the build direction;
+segments are chained into loops through the mesh's own edges (Minetto et al., Computer-Aided
+Design 2017), so a closed solid gives closed loops: outer loops counter-clockwise, holes
+clockwise, seen from +direction. In-layer coordinates are x and y for the default +Z build; for
+another direction they are two axes across it (stack.json and the JSON report name them).
+
+Outputs by name: .cli (CLI v2.0; z of a layer is its top), .svg (one group per layer), .sl1
+(Original Prusa SL1 display, uniform layers only), or a folder (name ending in /, or no
+extension): PNG masks at --pixel (or SVG files with --format svg), anti-aliased by exact pixel
+coverage. --csv: z (mid-height), thickness, area, perimeter, loops, holes per layer.
+
+Adaptive layers: 'area' keeps a layer while the cross-section area changes by at most C from
+the layer below (|S_n - S_n-1| / S_n <= C), halving it otherwise, down to --min-layer; 'cusp'
+keeps the stair-step cusp h * |cos(angle between normal and build direction)| under --cusp
+(Dolenc and Makela, Computer-Aided Design 1994).
+
+Exit code 0 when every loop closed; 1 when some chain could not close (the files are written,
+the open chains marked: CLI direction 2, red in SVG); 2 on bad input.";
+
+/// How adaptive layers are chosen.
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Adaptive {
+    /// By the change of cross-section area between layers (|S_n − S_n−1| / S_n ≤ C).
+    Area,
+    /// By the stair-step cusp height.
+    Cusp,
+}
+
+#[derive(Args)]
+pub struct SliceArgs {
+    /// Mesh file: .stl, .obj, .off, .ply or .3mf.
+    pub mesh: PathBuf,
+    /// Output: FILE.cli, FILE.svg, FILE.sl1, or a folder (DIR/) of PNG or SVG layers.
+    #[arg(short, long, value_name = "PATH")]
+    pub output: Option<PathBuf>,
+    /// Layer thickness, mm (uniform layers).
+    #[arg(long, value_name = "MM", default_value_t = 0.05, value_parser = super::parse_positive)]
+    pub layer: f64,
+    /// First layer's thickness, mm (uniform layers; default: --layer).
+    #[arg(long, value_name = "MM", value_parser = super::parse_positive)]
+    pub first_layer: Option<f64>,
+    /// Adaptive layers instead of uniform ones.
+    #[arg(long, value_enum)]
+    pub adaptive: Option<Adaptive>,
+    /// Largest relative change of area between layers (--adaptive area).
+    #[arg(long, value_name = "C", default_value_t = 0.1, value_parser = super::parse_positive)]
+    pub c: f64,
+    /// Largest cusp height, mm (--adaptive cusp).
+    #[arg(long, value_name = "MM", default_value_t = 0.01, value_parser = super::parse_positive)]
+    pub cusp: f64,
+    /// Thinnest adaptive layer, mm.
+    #[arg(long, value_name = "MM", default_value_t = 0.025, value_parser = super::parse_positive)]
+    pub min_layer: f64,
+    /// Thickest adaptive layer, mm.
+    #[arg(long, value_name = "MM", default_value_t = 0.2, value_parser = super::parse_positive)]
+    pub max_layer: f64,
+    /// Build direction.
+    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,1", value_parser = super::parse_finite3)]
+    pub direction: [f64; 3],
+    /// Binary CLI rather than ASCII (.cli output).
+    #[arg(long)]
+    pub binary: bool,
+    /// Pixel size of PNG masks, mm (folder output).
+    #[arg(long, value_name = "MM", default_value_t = 0.05, value_parser = super::parse_positive)]
+    pub pixel: f64,
+    /// What a folder output holds.
+    #[arg(long, value_enum, default_value = "png")]
+    pub format: FolderFormat,
+    /// Per-layer table: z, thickness, area, perimeter, loops, holes.
+    #[arg(long, value_name = "FILE.csv")]
+    pub csv: Option<PathBuf>,
+    /// Repair the mesh in memory when it is not a closed, outward solid.
+    #[arg(long)]
+    pub repair: bool,
+    /// Also search for self-intersecting facets (loops cross where facets do).
+    #[arg(long)]
+    pub self_intersections: bool,
+    /// Merge vertices closer than this (mm) when reading.
+    #[arg(long, value_name = "MM", default_value_t = 0.0, value_parser = super::parse_length0)]
+    pub weld_tolerance: f64,
+    /// Slice only this share of the layers, K of N (a folder output; also read from a Slurm
+    /// array task's environment).
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Also write the JSON report to this file.
+    #[arg(long, value_name = "FILE.json")]
+    pub report: Option<PathBuf>,
+}
+
+impl SliceArgs {
+    /// The slicing these arguments ask for.
+    pub fn options(&self) -> Result<SliceOptions> {
+        let rule = match self.adaptive {
+            None => Rule::Uniform {
+                layer: self.layer,
+                first: self.first_layer.unwrap_or(self.layer),
+            },
+            Some(Adaptive::Area) => Rule::Area {
+                c: self.c,
+                min: self.min_layer,
+                max: self.max_layer,
+            },
+            Some(Adaptive::Cusp) => Rule::Cusp {
+                cusp: self.cusp,
+                min: self.min_layer,
+                max: self.max_layer,
+            },
+        };
+        let output = self
+            .output
+            .as_deref()
+            .map(|p| Output::for_path(p, self.binary, self.pixel, self.format))
+            .transpose()?;
+        let shard = match &self.shard {
+            Some(s) => Some(latvox::batch::shard::Shard::parse(s)?),
+            None => latvox::batch::shard::Shard::from_slurm(|v| std::env::var(v).ok())?,
+        };
+        Ok(SliceOptions {
+            rule,
+            direction: self.direction,
+            output,
+            csv: self.csv.clone(),
+            shard: shard.map(|s| (s.index, s.count)),
+            repair: self.repair,
+            check: CheckOptions {
+                self_intersections: self.self_intersections,
+                tolerance: self.weld_tolerance,
+            },
+        })
+    }
+}
+
+pub fn run(a: &SliceArgs, quiet: bool) -> Result<i32> {
+    let opts = a.options()?;
+    if let Some(r) = &a.report {
+        latvox::io::atomic::check_writable(r)?;
+    }
+    let progress = latvox::progress::Progress::new(quiet);
+    let r = slice_file(&a.mesh, &opts, &progress)?;
+    if !super::emit_json(a.report.as_deref(), a.json, &r)? {
+        print_summary(&r);
+    }
+    Ok(if r.open_chains > 0 { 1 } else { 0 })
+}
+
+fn print_summary(r: &SliceReport) {
+    let d = r.direction;
+    let dir = if d == [0.0, 0.0, 1.0] {
+        "+Z".to_string()
+    } else {
+        format!("({:.4}, {:.4}, {:.4})", d[0], d[1], d[2])
+    };
+    let (t0, t1) = r.thickness;
+    let thick = if (t1 - t0).abs() <= 1e-9 * t1 {
+        format!("{t0} mm")
+    } else {
+        format!("{t0:.4}–{t1:.4} mm")
+    };
+    outln!(
+        "{}: {} facets, {} layers of {thick} along {dir}, heights {:.4} … {:.4} mm",
+        r.input,
+        r.facets,
+        r.layers,
+        r.heights[0],
+        r.heights[1]
+    );
+    if !r.repairs.is_empty() {
+        let list: Vec<String> = r.repairs.iter().map(|(k, n)| format!("{n} {k}")).collect();
+        outln!("repaired  {}", list.join(", "));
+    }
+    if r.written != (0, r.layers) {
+        outln!(
+            "shard     layers {} … {} of {}",
+            r.written.0,
+            r.written.1,
+            r.layers
+        );
+    }
+    outln!(
+        "loops     {} ({} holes), {} segments{}",
+        r.loops,
+        r.holes,
+        r.segments,
+        if r.open_chains > 0 {
+            format!(
+                "; {} OPEN CHAINS (layers {:?}…): the mesh is not a closed solid there",
+                r.open_chains, r.open_layers
+            )
+        } else {
+            String::new()
+        }
+    );
+    if let Some(n) = r.self_intersections.filter(|&n| n > 0) {
+        outln!("warning   {n} self-intersecting facet pairs: loops may cross where facets do");
+    }
+    if r.written == (0, r.layers) {
+        let rel = (r.layer_volume - r.mesh_volume) / r.mesh_volume.abs().max(1e-300);
+        outln!(
+            "volume    Σ area × thickness {:.4} mm³, mesh {:.4} mm³ ({:+.3} %)",
+            r.layer_volume,
+            r.mesh_volume,
+            100.0 * rel
+        );
+    }
+    outln!("wrote     {}", r.outputs.join(", "));
+}

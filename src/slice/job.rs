@@ -1,0 +1,465 @@
+//! Slicing a mesh file, as `latvox slice` and batch jobs do: read it, check that it is a closed,
+//! outward solid (or repair it in memory when asked), place the layers, cut them, and stream the
+//! sections to the writers a chunk of layers at a time — memory holds one chunk of sections,
+//! never the whole stack.
+
+use super::contour::{grow, merge, EMPTY_BOX};
+use super::mesh::{HeightIndex, MeshSlicer};
+use super::plan::{plan, Layer, Rule};
+use super::{Frame, Section, Stack, StackWriter};
+use crate::check::{check, CheckOptions};
+use crate::error::{Error, Result};
+use crate::field::Vec3;
+use crate::mesh::Mesh;
+use crate::progress::Progress;
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Where the layers go.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Output {
+    /// A Common Layer Interface file (ASCII or binary).
+    Cli {
+        /// The file.
+        path: PathBuf,
+        /// Binary rather than ASCII.
+        binary: bool,
+    },
+    /// One SVG file, a group per layer.
+    Svg(PathBuf),
+    /// A folder of SVG files, one per layer.
+    SvgDir(PathBuf),
+    /// A folder of PNG masks at a pixel size (mm).
+    PngDir {
+        /// The folder.
+        path: PathBuf,
+        /// Pixel size, mm.
+        pixel: f64,
+    },
+    /// A PrusaSlicer SL1 archive.
+    Sl1(PathBuf),
+}
+
+/// What kind of files a folder output holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FolderFormat {
+    /// PNG masks (DLP/SLA).
+    Png,
+    /// SVG contours.
+    Svg,
+}
+
+impl Output {
+    /// The output for `path` by its name: `.cli` (binary with `binary`), `.svg`, `.sl1`, or a
+    /// folder (a name ending in `/`, an existing folder, or a name without extension) of PNG
+    /// masks at `pixel` mm or of SVG files.
+    pub fn for_path(path: &Path, binary: bool, pixel: f64, folder: FolderFormat) -> Result<Output> {
+        let s = path.to_string_lossy();
+        let is_dir = s.ends_with('/') || path.is_dir() || path.extension().is_none();
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        let out = if is_dir {
+            let p = PathBuf::from(s.trim_end_matches('/'));
+            match folder {
+                FolderFormat::Png => Output::PngDir { path: p, pixel },
+                FolderFormat::Svg => Output::SvgDir(p),
+            }
+        } else {
+            match ext.as_deref() {
+                Some("cli") => Output::Cli {
+                    path: path.to_path_buf(),
+                    binary,
+                },
+                Some("svg") => Output::Svg(path.to_path_buf()),
+                Some("sl1") => Output::Sl1(path.to_path_buf()),
+                Some(e) => {
+                    return Err(Error::invalid(format!(
+                        "{}: unknown output extension '.{e}' (slices are written as .cli, .svg, .sl1 or a folder of PNG or SVG layers)",
+                        path.display()
+                    )))
+                }
+                None => unreachable!(),
+            }
+        };
+        if binary && !matches!(out, Output::Cli { .. }) {
+            return Err(Error::invalid(format!(
+                "{}: --binary applies to .cli files only",
+                path.display()
+            )));
+        }
+        Ok(out)
+    }
+
+    /// The file or folder written.
+    pub fn path(&self) -> &Path {
+        match self {
+            Output::Cli { path, .. } | Output::PngDir { path, .. } => path,
+            Output::Svg(p) | Output::SvgDir(p) | Output::Sl1(p) => p,
+        }
+    }
+
+    /// Whether the output is a folder of layer files (the only kind a shard can write).
+    pub fn is_folder(&self) -> bool {
+        matches!(self, Output::SvgDir(_) | Output::PngDir { .. })
+    }
+
+    /// Refuses up front what would fail after the work: a folder that cannot be made, a file
+    /// that cannot be written.
+    pub fn check_writable(&self) -> Result<()> {
+        let p = self.path();
+        if self.is_folder() {
+            if p.exists() && !p.is_dir() {
+                return Err(Error::invalid(format!(
+                    "{}: exists and is not a folder",
+                    p.display()
+                )));
+            }
+            let parent = match p.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d,
+                _ => Path::new("."),
+            };
+            if !parent.is_dir() {
+                return Err(Error::invalid(format!(
+                    "{}: the folder {} does not exist",
+                    p.display(),
+                    parent.display()
+                )));
+            }
+            Ok(())
+        } else {
+            crate::io::atomic::check_writable(p)
+        }
+    }
+
+    fn writer(&self, stack: &Stack, sharded: bool) -> Result<Box<dyn StackWriter>> {
+        Ok(match self {
+            Output::Cli { path, binary } => {
+                Box::new(super::cli_file::CliWriter::create(path, stack, *binary)?)
+            }
+            Output::Svg(p) => Box::new(super::svg::SvgWriter::create(p, stack)?),
+            Output::SvgDir(p) => Box::new(super::svg::SvgDirWriter::create(p, stack, sharded)?),
+            Output::PngDir { path, pixel } => Box::new(super::masks::PngDirWriter::create(
+                path, stack, *pixel, sharded,
+            )?),
+            Output::Sl1(p) => Box::new(super::masks::Sl1Writer::create(p, stack)?),
+        })
+    }
+}
+
+/// How to slice.
+#[derive(Debug, Clone)]
+pub struct SliceOptions {
+    /// How the layers are placed.
+    pub rule: Rule,
+    /// Build direction (any length but zero).
+    pub direction: Vec3,
+    /// The layer files, if any.
+    pub output: Option<Output>,
+    /// The per-layer CSV table, if asked.
+    pub csv: Option<PathBuf>,
+    /// Slice only shard `index` of `count` (from 0): a contiguous run of layers, written into a
+    /// shared folder.
+    pub shard: Option<(usize, usize)>,
+    /// Repair the mesh in memory first; without it, a mesh that is not a closed, outward solid
+    /// is refused.
+    pub repair: bool,
+    /// How the mesh is checked (and read: vertices within the tolerance merge).
+    pub check: CheckOptions,
+}
+
+/// What slicing did.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SliceReport {
+    /// The input, as named.
+    pub input: String,
+    /// Facets sliced.
+    pub facets: u64,
+    /// Self-intersecting facet pairs, when looked for (loops may cross where facets do).
+    pub self_intersections: Option<u64>,
+    /// Repairs made in memory (kinds and counts), when asked.
+    pub repairs: Vec<(String, u64)>,
+    /// The build direction, as a unit vector.
+    pub direction: Vec3,
+    /// How layers were placed.
+    pub rule: Rule,
+    /// Layers in the whole stack.
+    pub layers: usize,
+    /// The layers this run wrote (`first..end`; all unless sharded).
+    pub written: (usize, usize),
+    /// Thinnest and thickest layer, mm.
+    pub thickness: (f64, f64),
+    /// Lowest and highest heights of the part along the build direction, mm.
+    pub heights: [f64; 2],
+    /// Facet–plane crossings (segments) in the layers written.
+    pub segments: u64,
+    /// Closed loops, holes among them, and chains that could not close, over the layers written.
+    pub loops: u64,
+    /// Clockwise loops (holes).
+    pub holes: u64,
+    /// Chains that could not close (only from an invalid mesh).
+    pub open_chains: u64,
+    /// Layers with an open chain (their first few, by index).
+    pub open_layers: Vec<usize>,
+    /// The mesh's enclosed volume, mm³.
+    pub mesh_volume: f64,
+    /// Σ area × thickness over the layers written, mm³ (the whole volume, unsharded: a check of
+    /// the slices against the mesh).
+    pub layer_volume: f64,
+    /// The files written.
+    pub outputs: Vec<String>,
+}
+
+/// Layers cut and written per round: bounds the sections held at once.
+const CHUNK: usize = 64;
+
+/// Reads, checks (or repairs) and slices the mesh file `input`.
+pub fn slice_file(input: &Path, opts: &SliceOptions, progress: &Progress) -> Result<SliceReport> {
+    validate(opts)?;
+    let loaded = crate::check::read_file(input, &opts.check, progress)?;
+    let name = input
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "part".into());
+    let mut report = slice_mesh(&loaded.mesh, &name, opts, progress).map_err(|e| match e {
+        Error::Invalid(m) if m.starts_with("the mesh ") => {
+            Error::invalid(format!("{}: {}", input.display(), &m["the mesh ".len()..]))
+        }
+        e => e,
+    })?;
+    report.input = input.display().to_string();
+    Ok(report)
+}
+
+/// Refuses bad settings before any work.
+pub fn validate(opts: &SliceOptions) -> Result<()> {
+    opts.rule.validate()?;
+    Frame::new(opts.direction)?;
+    if let Some((k, n)) = opts.shard {
+        if k >= n {
+            return Err(Error::invalid(format!(
+                "shard {} of {n} does not exist",
+                k + 1
+            )));
+        }
+        if n > 1 && !opts.output.as_ref().is_some_and(Output::is_folder) {
+            return Err(Error::invalid(
+                "a shard writes its layers into a folder: give -o DIR/ (PNG or SVG layers)",
+            ));
+        }
+        if n > 1 && opts.csv.is_some() {
+            return Err(Error::invalid(
+                "--csv covers the whole stack: leave it out of sharded runs (slice unsharded for the table)",
+            ));
+        }
+    }
+    if let Some(Output::PngDir { pixel, .. }) = &opts.output {
+        if !(*pixel > 0.0 && pixel.is_finite()) {
+            return Err(Error::invalid(format!(
+                "the pixel size must be a positive length in mm, got {pixel}"
+            )));
+        }
+    }
+    if opts.output.is_none() && opts.csv.is_none() {
+        return Err(Error::invalid(
+            "nothing to write: give -o FILE (or a folder) and/or --csv FILE.csv",
+        ));
+    }
+    if let Some(o) = &opts.output {
+        o.check_writable()?;
+    }
+    if let Some(c) = &opts.csv {
+        crate::io::atomic::check_writable(c)?;
+    }
+    Ok(())
+}
+
+/// The defects that keep a mesh from being sliced into closed contours, as "N what" phrases.
+fn slicing_defects(r: &crate::check::CheckReport) -> Vec<String> {
+    let mut v = Vec::new();
+    if r.boundary_edges > 0 {
+        v.push(format!(
+            "open: {} boundary edges in {} holes",
+            r.boundary_edges, r.hole_loops
+        ));
+    }
+    for (n, what) in [
+        (r.non_manifold_edges, "non-manifold edges"),
+        (r.inconsistent_edges, "inconsistently wound edges"),
+        (r.inward_shells, "inward-facing shells"),
+        (r.non_orientable_shells, "non-orientable shells"),
+        (r.t_junctions, "T-junctions"),
+        (r.duplicate_facets, "duplicate facets"),
+    ] {
+        if n > 0 {
+            v.push(format!("{n} {what}"));
+        }
+    }
+    v
+}
+
+/// Checks (or repairs) and slices `mesh`, named `name` in the files.
+pub fn slice_mesh(
+    mesh: &Mesh,
+    name: &str,
+    opts: &SliceOptions,
+    progress: &Progress,
+) -> Result<SliceReport> {
+    validate(opts)?;
+    let report = {
+        let _s = progress.stage("checking");
+        let o = CheckOptions {
+            self_intersections: opts.check.self_intersections,
+            ..opts.check
+        };
+        check(mesh, None, &o)?
+    };
+    let defects = slicing_defects(&report);
+    let mut repairs = Vec::new();
+    let repaired;
+    let mesh = if defects.is_empty() {
+        mesh
+    } else if opts.repair {
+        let (m, r) = crate::repair::repair(mesh, &Default::default(), progress)?;
+        repairs = r
+            .changes
+            .iter()
+            .map(|c| (c.kind.to_string(), c.count))
+            .collect();
+        repaired = m;
+        &repaired
+    } else {
+        return Err(Error::invalid(format!(
+            "the mesh is not a closed, outward solid ({}): slice it with --repair, or mend it with latvox repair",
+            defects.join(", ")
+        )));
+    };
+    let frame = Frame::new(opts.direction)?;
+    let slicer = MeshSlicer::new(mesh, frame);
+    let Some((lo, hi)) = slicer.range() else {
+        return Err(Error::invalid("the mesh has no facets"));
+    };
+    let layers = {
+        let _s = progress.stage("placing layers");
+        match opts.rule {
+            Rule::Uniform { .. } => plan(&opts.rule, lo, hi, &NoProfile)?,
+            Rule::Area { min, .. } | Rule::Cusp { min, .. } => {
+                let index = HeightIndex::new(&slicer, min);
+                plan(&opts.rule, lo, hi, &index)?
+            }
+        }
+    };
+    let bounds = in_layer_bounds(mesh, &frame);
+    let stack = Stack {
+        layers: layers.clone(),
+        bounds,
+        heights: [lo, hi],
+        frame,
+        name: name.to_string(),
+    };
+    let (first, end) = match opts.shard {
+        Some((k, n)) => (layers.len() * k / n, layers.len() * (k + 1) / n),
+        None => (0, layers.len()),
+    };
+    let sharded = opts.shard.is_some_and(|(_, n)| n > 1);
+    let mut writers: Vec<Box<dyn StackWriter>> = Vec::new();
+    if let Some(o) = &opts.output {
+        writers.push(o.writer(&stack, sharded)?);
+    }
+    if let Some(c) = &opts.csv {
+        writers.push(Box::new(super::csv::CsvWriter::create(c, &stack)?));
+    }
+    let zs: Vec<f64> = layers[first..end].iter().map(|l: &Layer| l.z).collect();
+    let buckets = {
+        let _s = progress.stage("bucketing facets");
+        slicer.buckets(&zs)
+    };
+    let mut out = SliceReport {
+        input: name.to_string(),
+        facets: mesh.triangle_count() as u64,
+        self_intersections: report.self_intersections,
+        repairs,
+        direction: frame.d,
+        rule: opts.rule,
+        layers: layers.len(),
+        written: (first, end),
+        thickness: layers.iter().fold((f64::INFINITY, 0.0f64), |a, l| {
+            (a.0.min(l.thickness), a.1.max(l.thickness))
+        }),
+        heights: [lo, hi],
+        segments: buckets.len() as u64,
+        loops: 0,
+        holes: 0,
+        open_chains: 0,
+        open_layers: Vec::new(),
+        mesh_volume: mesh.volume(),
+        layer_volume: 0.0,
+        outputs: opts
+            .output
+            .iter()
+            .map(|o| o.path().display().to_string())
+            .chain(opts.csv.iter().map(|c| c.display().to_string()))
+            .collect(),
+    };
+    let counter = progress.counter((end - first) as u64, "layers");
+    for start in (first..end).step_by(CHUNK) {
+        let stop = (start + CHUNK).min(end);
+        let sections: Vec<Section> = (start..stop)
+            .into_par_iter()
+            .map(|k| slicer.section(layers[k].z, buckets.of(k - first)))
+            .collect();
+        for (k, s) in (start..stop).zip(&sections) {
+            let m = s.measures();
+            out.loops += m.loops as u64;
+            out.holes += m.holes as u64;
+            out.open_chains += m.open as u64;
+            if m.open > 0 && out.open_layers.len() < 16 {
+                out.open_layers.push(k);
+            }
+            out.layer_volume += m.area * layers[k].thickness;
+        }
+        for w in writers.iter_mut() {
+            let encoded: Vec<Result<Vec<u8>>> = (start..stop)
+                .into_par_iter()
+                .zip(sections.par_iter())
+                .map(|(k, s)| w.encode(k, s))
+                .collect();
+            for (k, e) in (start..stop).zip(encoded) {
+                w.put(k, e?)?;
+            }
+        }
+        for _ in start..stop {
+            counter.inc();
+        }
+    }
+    drop(counter);
+    {
+        let _s = progress.stage("writing");
+        for w in writers {
+            w.finish()?;
+        }
+    }
+    Ok(out)
+}
+
+/// The part's in-layer bounds, `[u_min, v_min, u_max, v_max]`.
+fn in_layer_bounds(mesh: &Mesh, frame: &Frame) -> [f64; 4] {
+    mesh.positions
+        .par_chunks_exact(3)
+        .map(|p| frame.plane([p[0] as f64, p[1] as f64, p[2] as f64]))
+        .fold(|| EMPTY_BOX, grow)
+        .reduce(|| EMPTY_BOX, merge)
+}
+
+/// The profile of uniform layers: they ask nothing.
+struct NoProfile;
+
+impl super::plan::Profile for NoProfile {
+    fn area(&self, _z: f64) -> f64 {
+        0.0
+    }
+    fn steepest_cos(&self, _z0: f64, _z1: f64) -> f64 {
+        0.0
+    }
+}
