@@ -733,3 +733,36 @@ fn inside(l: &[[f64; 2]], p: [f64; 2]) -> bool {
     }
     c
 }
+
+/// Batch jobs slice too: a CLI file with its table and a folder of masks, both skipped when the
+/// batch runs again.
+#[test]
+fn batch_jobs_slice_and_resume() {
+    let dir = tempdir();
+    let d = dir.path();
+    meshkit::write_stl(&d.join("ball.stl"), &meshkit::sphere(5.0, 24));
+    std::fs::write(
+        d.join("jobs.toml"),
+        "[[job]]\ncommand = \"slice\"\ninput = \"ball.stl\"\noutput = \"out/ball.cli\"\n\
+         layer = 0.1\ncsv = \"out/ball.csv\"\n\n[[job]]\ncommand = \"slice\"\ninput = \"ball.stl\"\n\
+         output = \"out/masks/\"\npixel = 0.2\nlayer = 0.5\n",
+    )
+    .unwrap();
+    let status = |d: &Path| -> Vec<String> {
+        json(&d.join("jobs-summary.json"))["jobs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r["status"].as_str().unwrap().to_string())
+            .collect()
+    };
+    ok(d, "batch jobs.toml -q");
+    assert_eq!(status(d), ["ok", "ok"]);
+    assert_eq!(csv_rows(&d.join("out/ball.csv")).len(), 100);
+    let j = cli_layers(&d.join("out/ball.cli"), None);
+    assert_eq!(j["layers"].as_array().unwrap().len(), 100);
+    assert!(d.join("out/masks/layer00019.png").is_file());
+    assert!(!d.join("out/masks/layer00020.png").exists());
+    ok(d, "batch jobs.toml -q");
+    assert_eq!(status(d), ["skipped", "skipped"]);
+}

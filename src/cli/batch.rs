@@ -14,6 +14,7 @@ use super::clap_message;
 use super::fill::FillArgs;
 use super::out::outln;
 use super::repair::RepairArgs;
+use super::slice::SliceArgs;
 use super::strut::StrutArgs;
 use super::topo::TopoArgs;
 use super::tpms::TpmsArgs;
@@ -58,9 +59,17 @@ Job file (paths relative to it; keys are the subcommand's long options):
   output = \"out/scan-fixed.stl\"
   drop-open-shells = true
 
-Jobs run the subcommands that make a part: tpms, strut, fill, topo and repair, with the options
-of `latvox tpms`, `latvox strut`, `latvox fill`, `latvox topo` and `latvox repair` (`input` is
-the input file).
+  [[job]]
+  command = \"slice\"              # a mesh cut into layers for the printer
+  input = \"out/bracket.stl\"
+  output = \"out/bracket.cli\"
+  layer = 0.05
+  csv = \"out/bracket-layers.csv\"
+
+Jobs run the subcommands that make a part — tpms, strut, fill, topo and repair — and slice,
+with the options of `latvox tpms`, `latvox strut`, `latvox fill`, `latvox topo`, `latvox
+repair` and `latvox slice` (`input` is the input file; a slice job passes when every loop
+closed).
 
 Examples:
   latvox batch jobs.toml                       # run all jobs, 1 worker per thread
@@ -114,13 +123,14 @@ fn parse_shard(s: &str) -> std::result::Result<Shard, String> {
 /// How a job of a given subcommand is turned into a task.
 type ParseJob = fn(&'static str, &Job) -> std::result::Result<Box<dyn Task>, String>;
 
-/// The subcommands a job file can run: those that make a part.
+/// The subcommands a job file can run: those that make a part, and slicing.
 const COMMANDS: &[(&str, ParseJob)] = &[
     ("tpms", parse_job::<TpmsArgs>),
     ("strut", parse_job::<StrutArgs>),
     ("fill", parse_job::<FillArgs>),
     ("topo", parse_job::<TopoArgs>),
     ("repair", parse_job::<RepairArgs>),
+    ("slice", parse_job::<SliceArgs>),
 ];
 
 impl Task for TpmsArgs {
@@ -176,6 +186,21 @@ impl Task for RepairArgs {
     fn run(&self) -> Result<TaskReport> {
         let r = super::repair::execute(self, &Progress::hidden())?;
         TaskReport::new(&r, &r.verdict, Vec::new())
+    }
+}
+
+impl Task for SliceArgs {
+    fn outputs(&self) -> Vec<PathBuf> {
+        super::slice::outputs(self)
+    }
+
+    fn run(&self) -> Result<TaskReport> {
+        let r = super::slice::execute(self, false, &Progress::hidden())?;
+        Ok(TaskReport {
+            report: serde_json::to_value(&r).map_err(|e| Error::invalid(e.to_string()))?,
+            passed: r.open_chains == 0,
+            warnings: Vec::new(),
+        })
     }
 }
 

@@ -54,7 +54,8 @@ pub enum Adaptive {
 #[derive(Args)]
 pub struct SliceArgs {
     /// Mesh file: .stl, .obj, .off, .ply or .3mf.
-    pub mesh: PathBuf,
+    #[arg(value_name = "MESH")]
+    pub input: PathBuf,
     /// Output: FILE.cli, FILE.svg, FILE.sl1, or a folder (DIR/) of PNG or SVG layers.
     #[arg(short, long, value_name = "PATH")]
     pub output: Option<PathBuf>,
@@ -116,8 +117,9 @@ pub struct SliceArgs {
 }
 
 impl SliceArgs {
-    /// The slicing these arguments ask for.
-    pub fn options(&self) -> Result<SliceOptions> {
+    /// The slicing these arguments ask for; `slurm`: with no --shard, a Slurm array task's
+    /// environment names the shard (not for a batch job: the batch shards its jobs).
+    pub fn options(&self, slurm: bool) -> Result<SliceOptions> {
         let rule = match self.adaptive {
             None => Rule::Uniform {
                 layer: self.layer,
@@ -141,7 +143,8 @@ impl SliceArgs {
             .transpose()?;
         let shard = match &self.shard {
             Some(s) => Some(latvox::batch::shard::Shard::parse(s)?),
-            None => latvox::batch::shard::Shard::from_slurm(|v| std::env::var(v).ok())?,
+            None if slurm => latvox::batch::shard::Shard::from_slurm(|v| std::env::var(v).ok())?,
+            None => None,
         };
         Ok(SliceOptions {
             rule,
@@ -159,16 +162,40 @@ impl SliceArgs {
 }
 
 pub fn run(a: &SliceArgs, quiet: bool) -> Result<i32> {
-    let opts = a.options()?;
-    if let Some(r) = &a.report {
-        latvox::io::atomic::check_writable(r)?;
-    }
-    let progress = latvox::progress::Progress::new(quiet);
-    let r = slice_file(&a.mesh, &opts, &progress)?;
+    let r = execute(a, true, &latvox::progress::Progress::new(quiet))?;
     if !super::emit_json(a.report.as_deref(), a.json, &r)? {
         print_summary(&r);
     }
     Ok(if r.open_chains > 0 { 1 } else { 0 })
+}
+
+/// Slices as `latvox slice` does (the report file written, if asked); `slurm` as for
+/// [`SliceArgs::options`].
+pub fn execute(
+    a: &SliceArgs,
+    slurm: bool,
+    progress: &latvox::progress::Progress,
+) -> Result<SliceReport> {
+    let opts = a.options(slurm)?;
+    if let Some(r) = &a.report {
+        latvox::io::atomic::check_writable(r)?;
+    }
+    slice_file(&a.input, &opts, progress)
+}
+
+/// The files a slicing job writes: the layer file (for a folder, its `stack.json`) and the
+/// table.
+pub fn outputs(a: &SliceArgs) -> Vec<PathBuf> {
+    let mut v = Vec::new();
+    if let Some(o) = a.options(false).ok().and_then(|o| o.output) {
+        v.push(if o.is_folder() {
+            o.path().join("stack.json")
+        } else {
+            o.path().to_path_buf()
+        });
+    }
+    v.extend(a.csv.clone());
+    v
 }
 
 fn print_summary(r: &SliceReport) {
@@ -218,8 +245,8 @@ fn print_summary(r: &SliceReport) {
             String::new()
         }
     );
-    if let Some(n) = r.self_intersections.filter(|&n| n > 0) {
-        outln!("warning   {n} self-intersecting facet pairs: loops may cross where facets do");
+    if r.self_intersecting == Some(true) {
+        outln!("warning   some facets intersect: loops may cross where they do");
     }
     if r.written == (0, r.layers) {
         let rel = (r.layer_volume - r.mesh_volume) / r.mesh_volume.abs().max(1e-300);

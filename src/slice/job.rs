@@ -7,6 +7,7 @@ use super::contour::{grow, merge, EMPTY_BOX};
 use super::mesh::{HeightIndex, MeshSlicer};
 use super::plan::{plan, Layer, Rule};
 use super::{Frame, Section, Stack, StackWriter};
+use crate::check::verify::{verify, Verify};
 use crate::check::{check, CheckOptions};
 use crate::error::{Error, Result};
 use crate::field::Vec3;
@@ -176,8 +177,8 @@ pub struct SliceReport {
     pub input: String,
     /// Facets sliced.
     pub facets: u64,
-    /// Self-intersecting facet pairs, when looked for (loops may cross where facets do).
-    pub self_intersections: Option<u64>,
+    /// Whether some facets intersect, when looked for (loops may cross where facets do).
+    pub self_intersecting: Option<bool>,
     /// Repairs made in memory (kinds and counts), when asked.
     pub repairs: Vec<(String, u64)>,
     /// The build direction, as a unit vector.
@@ -307,15 +308,31 @@ pub fn slice_mesh(
     progress: &Progress,
 ) -> Result<SliceReport> {
     validate(opts)?;
-    let report = {
+    // The linear-time verification of made parts first; the full check (every defect counted)
+    // only to say what is wrong with a mesh that fails it.
+    let verified = {
         let _s = progress.stage("checking");
+        let how = if opts.check.self_intersections {
+            Verify::Full
+        } else {
+            Verify::Fast
+        };
+        verify(mesh, how, progress)?
+    };
+    let defects = if verified.closed && verified.manifold && verified.outward {
+        Vec::new()
+    } else {
+        let _s = progress.stage("counting defects");
         let o = CheckOptions {
-            self_intersections: opts.check.self_intersections,
+            self_intersections: false,
             ..opts.check
         };
-        check(mesh, None, &o)?
+        let mut d = slicing_defects(&check(mesh, None, &o)?);
+        if d.is_empty() {
+            d.push("not closed, manifold and facing out".into());
+        }
+        d
     };
-    let defects = slicing_defects(&report);
     let mut repairs = Vec::new();
     let repaired;
     let mesh = if defects.is_empty() {
@@ -378,7 +395,9 @@ pub fn slice_mesh(
     let mut out = SliceReport {
         input: name.to_string(),
         facets: mesh.triangle_count() as u64,
-        self_intersections: report.self_intersections,
+        self_intersecting: verified
+            .self_intersection_checked
+            .then_some(verified.self_intersecting),
         repairs,
         direction: frame.d,
         rule: opts.rule,

@@ -132,11 +132,12 @@ impl LayerDir {
     }
 }
 
-/// What `stack.json` says of a PNG stack.
+/// What `stack.json` says of a folder of layer files.
 #[derive(serde::Serialize)]
 struct Manifest<'a> {
     part: &'a str,
-    grid: PixelGrid,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    grid: Option<PixelGrid>,
     direction: [f64; 3],
     u_axis: [f64; 3],
     v_axis: [f64; 3],
@@ -150,6 +151,36 @@ struct ManifestLayer {
     thickness: f64,
 }
 
+/// Writes `stack.json` into `dir`: the part, the frame, the pixel grid (for masks) and every
+/// layer's file (`layer00000.EXT` …), mid-height and thickness.
+pub(crate) fn write_manifest(
+    dir: &LayerDir,
+    stack: &Stack,
+    grid: Option<PixelGrid>,
+    ext: &str,
+) -> Result<()> {
+    let manifest = Manifest {
+        part: &stack.name,
+        grid,
+        direction: stack.frame.d,
+        u_axis: stack.frame.u,
+        v_axis: stack.frame.v,
+        layers: stack
+            .layers
+            .iter()
+            .enumerate()
+            .map(|(k, l)| ManifestLayer {
+                file: format!("layer{k:05}.{ext}"),
+                z: l.z,
+                thickness: l.thickness,
+            })
+            .collect(),
+    };
+    let json = serde_json::to_vec_pretty(&manifest)
+        .map_err(|e| Error::io(&dir.path, std::io::Error::other(e)))?;
+    dir.put("stack.json", &json)
+}
+
 /// A folder of PNG masks and its `stack.json`.
 pub struct PngDirWriter {
     dir: LayerDir,
@@ -161,25 +192,7 @@ impl PngDirWriter {
     pub fn create(path: &Path, stack: &Stack, pixel: f64, sharded: bool) -> Result<PngDirWriter> {
         let grid = PixelGrid::around(stack.bounds, pixel)?;
         let dir = LayerDir::create(path, sharded)?;
-        let manifest = Manifest {
-            part: &stack.name,
-            grid,
-            direction: stack.frame.d,
-            u_axis: stack.frame.u,
-            v_axis: stack.frame.v,
-            layers: stack
-                .layers
-                .iter()
-                .enumerate()
-                .map(|(k, l)| ManifestLayer {
-                    file: format!("layer{k:05}.png"),
-                    z: l.z,
-                    thickness: l.thickness,
-                })
-                .collect(),
-        };
-        let json = serde_json::to_vec_pretty(&manifest).map_err(std::io::Error::other);
-        dir.put("stack.json", &json.map_err(|e| Error::io(path, e))?)?;
+        write_manifest(&dir, stack, Some(grid), "png")?;
         Ok(PngDirWriter { dir, grid })
     }
 }

@@ -107,7 +107,7 @@ impl StackWriter for SvgWriter {
     }
 }
 
-/// A folder of SVG files, `layer00000.svg` …, one per layer.
+/// A folder of SVG files, `layer00000.svg` …, one per layer, and `stack.json`.
 pub struct SvgDirWriter {
     dir: super::masks::LayerDir,
     stack: Stack,
@@ -117,8 +117,10 @@ impl SvgDirWriter {
     /// Starts the folder `path` (a shard writes its files into it; otherwise it is replaced
     /// whole on finishing).
     pub fn create(path: &Path, stack: &Stack, sharded: bool) -> Result<SvgDirWriter> {
+        let dir = super::masks::LayerDir::create(path, sharded)?;
+        super::masks::write_manifest(&dir, stack, None, "svg")?;
         Ok(SvgDirWriter {
-            dir: super::masks::LayerDir::create(path, sharded)?,
+            dir,
             stack: stack.clone(),
         })
     }
