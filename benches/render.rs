@@ -13,19 +13,11 @@
 mod child;
 #[path = "../tests/meshkit/mod.rs"]
 mod meshkit;
+mod support;
 
 use child::run_measured;
 use std::path::Path;
-use std::process::{Command, Stdio};
-
-fn latvox(dir: &Path, args: &[&str]) -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_latvox"));
-    c.args(args)
-        .current_dir(dir)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null());
-    c
-}
+use support::latvox;
 
 /// Median seconds and median peak memory (MB) of `runs` runs of each command in turn (one
 /// process after another; the case's time is their sum).

@@ -14,19 +14,12 @@
 
 #[path = "../tests/common/child.rs"]
 mod child;
+mod support;
 
 use child::run_measured;
 use std::path::Path;
 use std::process::{Command, Stdio};
-
-fn latvox(dir: &Path, args: &[&str]) -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_latvox"));
-    c.args(args)
-        .current_dir(dir)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null());
-    c
-}
+use support::latvox;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);

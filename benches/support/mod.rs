@@ -1,6 +1,6 @@
 //! What the benchmarks share: the process's peak memory, a sink that makes STL records and
-//! drops them (the writing of a part too large for this machine's disk, without the disk), and
-//! a torus mesh.
+//! drops them (the writing of a part too large for this machine's disk, without the disk),
+//! a torus mesh, and latvox as a quiet child process.
 #![allow(dead_code)]
 
 use latvox::io::sink::{MeshSink, Triangle};
@@ -77,4 +77,15 @@ pub fn torus(big: f64, small: f64, nu: usize, nv: usize) -> Mesh {
         }
     }
     Mesh { positions, indices }
+}
+
+/// latvox run in `dir` with `args`, its output dropped.
+pub fn latvox(dir: &std::path::Path, args: &[&str]) -> std::process::Command {
+    use std::process::Stdio;
+    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_latvox"));
+    c.args(args)
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null());
+    c
 }
