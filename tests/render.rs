@@ -272,6 +272,7 @@ fn sphere_tracing_never_tunnels() {
     for solid in models {
         let model = Model {
             solid,
+            level: 0.0,
             voxel,
             cell: 4.0,
         };

@@ -9,6 +9,10 @@
 //! the reverse). Where the file names a file by a relative path (a cell file, the part filled,
 //! the solids kept), it is relative to the part file.
 
+use super::clap_message;
+use clap::{Args, FromArgMatches};
+use latvox::fill::traced::Traced;
+use latvox::render::Model;
 use latvox::{Error, Result};
 use std::path::Path;
 
@@ -256,4 +260,72 @@ pub fn expand(command: &str, argv: Vec<String>) -> Result<Vec<String>> {
     }
     front.extend(argv);
     Ok(front)
+}
+
+/// What a part file describes, ready to trace: a lattice block as an implicit model, or a
+/// filled part as its meshes and lattice.
+pub(crate) enum Part {
+    /// A TPMS or strut part.
+    Block(Model),
+    /// A filled part.
+    Filled(Box<Traced>),
+}
+
+/// A part file's part.
+pub(crate) fn part_of(path: &Path) -> Result<Part> {
+    let table = super::part::read(path)?;
+    let command = table
+        .get("command")
+        .and_then(toml::Value::as_str)
+        .unwrap_or_default()
+        .to_string();
+    let argv = vec!["--part".to_string(), path.display().to_string()];
+    // A setting the part file gives wrongly: said of the part file.
+    let named = |e: Error| match e {
+        Error::Invalid(m) if !m.contains(&path.display().to_string()) => {
+            Error::invalid(format!("{}: {m}", path.display()))
+        }
+        e => e,
+    };
+    part_from(&command, argv, path).map_err(named)
+}
+
+fn part_from(command: &str, argv: Vec<String>, path: &Path) -> Result<Part> {
+    match command {
+        "tpms" => Ok(Part::Block(
+            parse::<super::tpms::TpmsArgs>("tpms", argv)?
+                .job()?
+                .model()?,
+        )),
+        "strut" => Ok(Part::Block(
+            parse::<super::strut::StrutArgs>("strut", argv)?
+                .job()?
+                .model()?,
+        )),
+        "fill" => Ok(Part::Filled(Box::new(
+            parse::<super::fill::FillArgs>("fill", argv)?
+                .job()?
+                .traced()?,
+        ))),
+        _ => Err(Error::invalid(format!(
+            "{}: a part file needs `command` (\"tpms\", \"strut\" or \"fill\")",
+            path.display()
+        ))),
+    }
+}
+
+fn parse<A: Args + FromArgMatches>(name: &'static str, argv: Vec<String>) -> Result<A> {
+    let argv = expand(name, argv)?;
+    let mut cmd = A::augment_args(clap::Command::new(name))
+        .no_binary_name(true)
+        .disable_help_flag(true);
+    let m = cmd
+        .try_get_matches_from_mut(argv)
+        .map_err(|e| Error::invalid(clap_message(e)))?;
+    A::from_arg_matches(&m).map_err(|e| Error::invalid(clap_message(e)))
+}
+
+pub(crate) fn is_part_file(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
 }

@@ -2,9 +2,12 @@
 //! table.
 
 use super::out::outln;
+use super::part::{is_part_file, part_of, Part};
 use clap::{Args, ValueEnum};
 use latvox::check::CheckOptions;
-use latvox::slice::job::{slice_file, FolderFormat, Output, SliceOptions, SliceReport};
+use latvox::slice::job::{
+    slice_file, slice_implicit, validate, FolderFormat, Output, SliceOptions, SliceReport,
+};
 use latvox::slice::plan::Rule;
 use latvox::Result;
 use std::path::PathBuf;
@@ -16,7 +19,8 @@ Examples:
   latvox slice part.3mf -o layers/ --pixel 0.05              # PNG masks for DLP/SLA + stack.json
   latvox slice part.stl -o part.sl1 --layer 0.05             # PrusaSlicer SL1 archive
   latvox slice part.stl -o part.svg --direction 0,1,1        # SVG stack, tilted build
-  latvox slice part.stl --csv p.csv --adaptive area --c 0.1 --min-layer 0.025 --max-layer 0.2
+  latvox slice part.stl --csv p.csv --plot p.png --adaptive area --c 0.1 \\
+      --min-layer 0.025 --max-layer 0.2                      # adaptive layers, plotted
   latvox slice part.stl --csv p.csv --adaptive cusp --cusp 0.01
   latvox slice scan.stl -o scan.cli --repair                 # mend an open mesh in memory first
   latvox slice big.stl -o layers/ --shard 3/8                # one task of a Slurm array
@@ -32,7 +36,8 @@ another direction they are two axes across it (stack.json and the JSON report na
 Outputs by name: .cli (CLI v2.0; z of a layer is its top), .svg (one group per layer), .sl1
 (Original Prusa SL1 display, uniform layers only), or a folder (name ending in /, or no
 extension): PNG masks at --pixel (or SVG files with --format svg), anti-aliased by exact pixel
-coverage. --csv: z (mid-height), thickness, area, perimeter, loops, holes per layer.
+coverage. --csv: z (mid-height), thickness, area, perimeter, loops, holes per layer; --plot:
+layer thickness and area against height.
 
 Adaptive layers: 'area' keeps a layer while the cross-section area changes by at most C from
 the layer below (|S_n - S_n-1| / S_n <= C), halving it otherwise, down to --min-layer; 'cusp'
@@ -53,9 +58,14 @@ pub enum Adaptive {
 
 #[derive(Args)]
 pub struct SliceArgs {
-    /// Mesh file: .stl, .obj, .off, .ply or .3mf.
-    #[arg(value_name = "MESH")]
+    /// Mesh file (.stl, .obj, .off, .ply, .3mf), or a part file (.toml, from --save-part):
+    /// a part file is sliced from its implicit solid, never meshed.
+    #[arg(value_name = "MESH|PART")]
     pub input: PathBuf,
+    /// Sample spacing on each layer for a part file, mm (default: a quarter of the voxel the
+    /// part would be meshed at, and no coarser than --pixel for masks).
+    #[arg(long, value_name = "MM", value_parser = super::parse_positive)]
+    pub sample: Option<f64>,
     /// Output: FILE.cli, FILE.svg, FILE.sl1, or a folder (DIR/) of PNG or SVG layers.
     #[arg(short, long, value_name = "PATH")]
     pub output: Option<PathBuf>,
@@ -95,6 +105,9 @@ pub struct SliceArgs {
     /// Per-layer table: z, thickness, area, perimeter, loops, holes.
     #[arg(long, value_name = "FILE.csv")]
     pub csv: Option<PathBuf>,
+    /// Plot of layer thickness and area against height (PNG).
+    #[arg(long, value_name = "FILE.png")]
+    pub plot: Option<PathBuf>,
     /// Repair the mesh in memory when it is not a closed, outward solid.
     #[arg(long)]
     pub repair: bool,
@@ -151,6 +164,7 @@ impl SliceArgs {
             direction: self.direction,
             output,
             csv: self.csv.clone(),
+            plot: self.plot.clone(),
             shard: shard.map(|s| (s.index, s.count)),
             repair: self.repair,
             check: CheckOptions {
@@ -180,7 +194,52 @@ pub fn execute(
     if let Some(r) = &a.report {
         latvox::io::atomic::check_writable(r)?;
     }
-    slice_file(&a.input, &opts, progress)
+    if !is_part_file(&a.input) {
+        if a.sample.is_some() {
+            return Err(latvox::Error::invalid(
+                "--sample is for part files (.toml): a mesh is cut exactly",
+            ));
+        }
+        return slice_file(&a.input, &opts, progress);
+    }
+    validate(&opts)?;
+    let name = a
+        .input
+        .file_stem()
+        .map_or_else(|| "part".into(), |s| s.to_string_lossy().into_owned());
+    let spacing = |voxel: f64| {
+        a.sample.unwrap_or_else(|| {
+            let h = 0.25 * voxel;
+            match &opts.output {
+                Some(Output::PngDir { pixel, .. }) => h.min(*pixel),
+                Some(Output::Sl1(_)) => h.min(latvox::slice::masks::SL1_DISPLAY.2),
+                _ => h,
+            }
+        })
+    };
+    let mut r = match part_of(&a.input)? {
+        Part::Block(model) => {
+            let field = model.field();
+            let h = spacing(model.voxel);
+            let r = slice_implicit(&*field, &model.bounds(), h, &name, &opts, progress)?;
+            SliceReport {
+                level: Some(model.level),
+                ..r
+            }
+        }
+        Part::Filled(traced) => {
+            let lattice = traced.lattice_field();
+            let scene = traced.scene(&*lattice, None);
+            let h = spacing(traced.voxel);
+            let r = slice_implicit(&scene, &traced.bounds, h, &name, &opts, progress)?;
+            SliceReport {
+                level: Some(traced.level),
+                ..r
+            }
+        }
+    };
+    r.input = a.input.display().to_string();
+    Ok(r)
 }
 
 /// The files a slicing job writes: the layer file (for a folder, its `stack.json`) and the
@@ -195,6 +254,7 @@ pub fn outputs(a: &SliceArgs) -> Vec<PathBuf> {
         });
     }
     v.extend(a.csv.clone());
+    v.extend(a.plot.clone());
     v
 }
 
@@ -248,14 +308,19 @@ fn print_summary(r: &SliceReport) {
     if r.self_intersecting == Some(true) {
         outln!("warning   some facets intersect: loops may cross where they do");
     }
-    if r.written == (0, r.layers) {
-        let rel = (r.layer_volume - r.mesh_volume) / r.mesh_volume.abs().max(1e-300);
-        outln!(
-            "volume    Σ area × thickness {:.4} mm³, mesh {:.4} mm³ ({:+.3} %)",
-            r.layer_volume,
-            r.mesh_volume,
-            100.0 * rel
-        );
+    match r.mesh_volume {
+        Some(v) if r.written == (0, r.layers) => {
+            let rel = (r.layer_volume - v) / v.abs().max(1e-300);
+            outln!(
+                "volume    Σ area × thickness {:.4} mm³, mesh {v:.4} mm³ ({:+.3} %)",
+                r.layer_volume,
+                100.0 * rel
+            );
+        }
+        None if r.written == (0, r.layers) => {
+            outln!("volume    Σ area × thickness {:.4} mm³", r.layer_volume);
+        }
+        _ => {}
     }
     outln!("wrote     {}", r.outputs.join(", "));
 }

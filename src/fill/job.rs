@@ -246,14 +246,14 @@ impl FillJob {
                         "sheet walls",
                     )
                 });
-                let make = |bounds: Aabb| LatticeFamily {
+                let make = |bounds: Aabb, phase: Vec3| LatticeFamily {
                     part: Lattice {
                         surface: s,
                         structure: st,
                         level: t0,
                         cell: self.cell,
                         bounds,
-                        phase: bounds.min,
+                        phase,
                     },
                 };
                 self.run_with(
@@ -274,14 +274,14 @@ impl FillJob {
                 }
                 let factor = cell.radii.iter().cloned().fold(f64::INFINITY, f64::min);
                 let across = 2.0 * r0 * factor * self.resolution as f64 / self.min_cell();
-                let make = |bounds: Aabb| StrutFamily {
+                let make = |bounds: Aabb, phase: Vec3| StrutFamily {
                     part: StrutLattice {
                         cell: cell.clone(),
                         size: self.cell,
                         radius: r0,
                         blend: self.blend,
                         bounds,
-                        phase: bounds.min,
+                        phase,
                     },
                     model: model.clone(),
                 };
@@ -328,7 +328,7 @@ impl FillJob {
         part: &Mesh,
         keep: &[Mesh],
         changes: Vec<Change>,
-        make: impl Fn(Aabb) -> F,
+        make: impl Fn(Aabb, Vec3) -> F,
         start_level: f64,
         members: Option<(f64, f64, &str)>,
         start: Instant,
@@ -358,7 +358,7 @@ impl FillJob {
                 let _p = progress.stage("building the part's distance field");
                 self.shape(part, keep, voxel)?
             };
-            let lattice = make(shape.bounds);
+            let lattice = make(shape.bounds, shape.corner);
             let solid = |infill| FillSolid {
                 shape: shape.clone(),
                 skin: self.skin,

@@ -57,6 +57,8 @@ pub struct Shape {
     /// The box the filled part is meshed in: the part and the kept solids, grown by two voxels
     /// so that it never clips them.
     pub bounds: Aabb,
+    /// The lower corner of the part and the kept solids (before growing): where cells start.
+    pub corner: Vec3,
     /// Voxel edge, mm.
     pub voxel: f64,
     /// Drain holes: axis from the part's surface inward, and radius, mm.
@@ -144,6 +146,7 @@ impl Shape {
         Ok(Shape {
             part: grid,
             keep: grids,
+            corner: bounds.min,
             bounds: bounds.grown(2.0 * voxel),
             voxel,
             drains: Vec::new(),

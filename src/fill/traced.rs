@@ -10,7 +10,7 @@
 use super::job::{closed, FillJob, Infilling};
 use super::shape::{skin_or_lattice, Drain};
 use crate::error::Result;
-use crate::field::{intersection_clearance, Aabb, Field, Vec3};
+use crate::field::{intersection_clearance, union_clearance, Aabb, Field, Vec3};
 use crate::grid::GridSpec;
 use crate::mesh::pipeline::Solid;
 use crate::render::bvh::Bvh;
@@ -35,6 +35,8 @@ pub struct Traced {
     pub voxel: f64,
     /// The shortest cell side, mm.
     pub cell: f64,
+    /// The lattice's TPMS level, or its strut radius (mm).
+    pub level: f64,
 }
 
 impl FillJob {
@@ -62,23 +64,31 @@ impl FillJob {
             bounds.min = [0, 1, 2].map(|a| bounds.min[a].min(b.min[a]));
             bounds.max = [0, 1, 2].map(|a| bounds.max[a].max(b.max[a]));
         }
-        let lattice: Box<dyn Solid + Send> = match &self.lattice {
-            Infilling::Tpms { surface, structure } => Box::new(Lattice {
-                surface: *surface,
-                structure: *structure,
-                level: calibrate::analytic_level(*surface, *structure, self.density),
-                cell: self.cell,
-                bounds,
-                phase: bounds.min,
-            }),
-            Infilling::Strut { cell } => Box::new(StrutLattice {
-                cell: cell.clone(),
-                size: self.cell,
-                radius: RadiusModel::new(cell, self.cell).radius(self.density),
-                blend: self.blend,
-                bounds,
-                phase: bounds.min,
-            }),
+        let (lattice, level): (Box<dyn Solid + Send>, f64) = match &self.lattice {
+            Infilling::Tpms { surface, structure } => {
+                let level = calibrate::analytic_level(*surface, *structure, self.density);
+                let solid = Lattice {
+                    surface: *surface,
+                    structure: *structure,
+                    level,
+                    cell: self.cell,
+                    bounds,
+                    phase: bounds.min,
+                };
+                (Box::new(solid), level)
+            }
+            Infilling::Strut { cell } => {
+                let radius = RadiusModel::new(cell, self.cell).radius(self.density);
+                let solid = StrutLattice {
+                    cell: cell.clone(),
+                    size: self.cell,
+                    radius,
+                    blend: self.blend,
+                    bounds,
+                    phase: bounds.min,
+                };
+                (Box::new(solid), radius)
+            }
         };
         Ok(Traced {
             part,
@@ -90,6 +100,7 @@ impl FillJob {
             bounds,
             voxel,
             cell: self.min_cell(),
+            level,
         })
     }
 }
@@ -125,6 +136,36 @@ pub struct FilledScene<'a> {
     traced: &'a Traced,
     lattice: &'a dyn Field,
     section: Option<Section>,
+}
+
+/// The filled part as an implicit solid (negative inside): the skin or lattice inside the part,
+/// less the drain holes, with the kept solids. What slicing samples; one BVH parity test per
+/// point decides inside the part.
+impl Field for FilledScene<'_> {
+    fn value(&self, p: Vec3) -> f64 {
+        self.value_and_clearance(p).0
+    }
+
+    fn clearance(&self, p: Vec3) -> f64 {
+        self.value_and_clearance(p).1
+    }
+
+    fn value_and_clearance(&self, p: Vec3) -> (f64, f64) {
+        let t = self.traced;
+        let cap = t.skin + t.blend + t.reach() + t.voxel;
+        let surface = t.part.distance(p, cap);
+        let (v, c) = if t.part.contains(p) {
+            let (v, c) = self.inside(p);
+            (v, c.min(surface))
+        } else {
+            (surface.max(1e-12), surface)
+        };
+        t.keep.iter().fold((v, c), |(v, c), k| {
+            let d = k.distance(p, cap);
+            let dk = if k.contains(p) { -d } else { d };
+            (v.min(dk), union_clearance(v, c, dk, d))
+        })
+    }
 }
 
 /// A small step past a surface a ray was cast to, mm (relative to the part's size).

@@ -19,12 +19,14 @@ use rayon::prelude::*;
 use std::path::Path;
 use trace::{Scene, Tolerance};
 
-/// A part as an implicit solid, at the level its model gives for its density (the meshed part's
-/// level differs from it by the meshing's own correction, a fraction of a voxel): what
-/// rendering and slicing trace instead of a mesh.
+/// A part as an implicit solid, at the level its part is meshed at (a TPMS's level calibrated
+/// for the part's own cells and voxel) or its strut radius: what rendering and slicing trace
+/// instead of a mesh. Its field is unclipped; the box clips it.
 pub struct Model {
-    /// The solid, clipped by its box.
+    /// The solid (its field unclipped; [`Solid::bounds`] is the clipping box).
     pub solid: Box<dyn Solid + Send>,
+    /// The TPMS level, or the strut radius (mm), the solid is built at.
+    pub level: f64,
     /// The voxel meshing it would use, mm: the scale of its finest features.
     pub voxel: f64,
     /// The shortest cell side, mm.

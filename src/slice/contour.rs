@@ -1,6 +1,7 @@
-//! Plane contours: closed loops of a section, measured (area, perimeter) and nested into polygons
-//! with holes. Loops follow one convention everywhere: the solid on the left, so outer boundaries
-//! run counter-clockwise and holes clockwise.
+//! Plane contours: closed loops of a section — from a mesh, or by marching squares over samples
+//! of a field ([`iso_loops`]) — measured (area, perimeter) and nested into polygons with holes.
+//! Loops follow one convention everywhere: the solid on the left, so outer boundaries run
+//! counter-clockwise and holes clockwise.
 
 /// A closed polyline in mm (first point not repeated at the end).
 pub type Loop = Vec<[f64; 2]>;
@@ -163,6 +164,99 @@ pub fn polygons(loops: &[Loop]) -> Vec<Polygon> {
         }
     }
     polys
+}
+
+/// Loops of `{f ≥ level}` by marching squares over an `n[0] × n[1]` grid of samples `f(i, j)`,
+/// in grid units (sample `(i, j)` at `(i, j)`), solid on the left. Beyond the grid the value is
+/// `outside` (below `level`), so every loop closes. Saddle cells are resolved by the cell-centre
+/// average; a crossing is never put exactly on a sample, so loops never touch.
+pub fn iso_loops(
+    n: [usize; 2],
+    f: impl Fn(usize, usize) -> f64,
+    level: f64,
+    outside: f64,
+) -> Vec<Loop> {
+    let (nx, ny) = (n[0], n[1]);
+    let (w, hgt) = (nx + 2, ny + 2);
+    let val = |i: usize, j: usize| -> f64 {
+        if i == 0 || j == 0 || i > nx || j > ny {
+            outside
+        } else {
+            f(i - 1, j - 1)
+        }
+    };
+    let inside = |i: usize, j: usize| val(i, j) >= level;
+    // Edge ids: horizontal (i,j)-(i+1,j) and vertical (i,j)-(i,j+1).
+    let hid = |i: usize, j: usize| j * (w - 1) + i;
+    let voff = (w - 1) * hgt;
+    let vid = |i: usize, j: usize| voff + j * w + i;
+    let total = voff + w * (hgt - 1);
+    let mut next = vec![u32::MAX; total];
+    for j in 0..hgt - 1 {
+        for i in 0..w - 1 {
+            let c = [
+                inside(i, j),
+                inside(i + 1, j),
+                inside(i + 1, j + 1),
+                inside(i, j + 1),
+            ];
+            if c.iter().all(|&b| b) || c.iter().all(|&b| !b) {
+                continue;
+            }
+            // Edges walked counter-clockwise: bottom, right, top, left.
+            let e = [hid(i, j), vid(i + 1, j), hid(i, j + 1), vid(i, j)];
+            let exits: Vec<usize> = (0..4).filter(|&k| c[k] && !c[(k + 1) % 4]).collect();
+            let entries: Vec<usize> = (0..4).filter(|&k| !c[k] && c[(k + 1) % 4]).collect();
+            if exits.len() == 1 {
+                next[e[exits[0]]] = e[entries[0]] as u32;
+            } else {
+                // Saddle: two solid corners on a diagonal.
+                let centre = 0.25 * (val(i, j) + val(i + 1, j) + val(i + 1, j + 1) + val(i, j + 1));
+                for &x in &exits {
+                    // Joined through the centre: pair each exit with the following entry;
+                    // separate: with the preceding one.
+                    let en = if centre >= level {
+                        (x + 1) % 4
+                    } else {
+                        (x + 3) % 4
+                    };
+                    next[e[x]] = e[en] as u32;
+                }
+            }
+        }
+    }
+    let point = |id: usize| -> [f64; 2] {
+        let ((i0, j0), (i1, j1)) = if id < voff {
+            let (j, i) = (id / (w - 1), id % (w - 1));
+            ((i, j), (i + 1, j))
+        } else {
+            let k = id - voff;
+            let (j, i) = (k / w, k % w);
+            ((i, j), (i, j + 1))
+        };
+        let (a, b) = (val(i0, j0), val(i1, j1));
+        let t = ((level - a) / (b - a)).clamp(1e-3, 1.0 - 1e-3);
+        let p = |i: usize| i as f64 - 1.0;
+        [p(i0) + t * (p(i1) - p(i0)), p(j0) + t * (p(j1) - p(j0))]
+    };
+    let mut out = Vec::new();
+    for s in 0..total {
+        if next[s] == u32::MAX {
+            continue;
+        }
+        let mut l = Vec::new();
+        let mut cur = s;
+        while next[cur] != u32::MAX {
+            l.push(point(cur));
+            let n = next[cur] as usize;
+            next[cur] = u32::MAX;
+            cur = n;
+        }
+        if l.len() >= 3 {
+            out.push(l);
+        }
+    }
+    out
 }
 
 /// A 2-D box `[xmin, ymin, xmax, ymax]` holding nothing.

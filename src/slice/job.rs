@@ -4,13 +4,14 @@
 //! never the whole stack.
 
 use super::contour::{grow, merge, EMPTY_BOX};
+use super::implicit::ImplicitSlicer;
 use super::mesh::{HeightIndex, MeshSlicer};
-use super::plan::{plan, Layer, Rule};
+use super::plan::{plan, Rule};
 use super::{Frame, Section, Stack, StackWriter};
 use crate::check::verify::{verify, Verify};
 use crate::check::{check, CheckOptions};
 use crate::error::{Error, Result};
-use crate::field::Vec3;
+use crate::field::{Aabb, Field, Vec3};
 use crate::mesh::Mesh;
 use crate::progress::Progress;
 use rayon::prelude::*;
@@ -160,6 +161,8 @@ pub struct SliceOptions {
     pub output: Option<Output>,
     /// The per-layer CSV table, if asked.
     pub csv: Option<PathBuf>,
+    /// The plot of layer thickness and area against height (PNG), if asked.
+    pub plot: Option<PathBuf>,
     /// Slice only shard `index` of `count` (from 0): a contiguous run of layers, written into a
     /// shared folder.
     pub shard: Option<(usize, usize)>,
@@ -203,8 +206,10 @@ pub struct SliceReport {
     pub open_chains: u64,
     /// Layers with an open chain (their first few, by index).
     pub open_layers: Vec<usize>,
-    /// The mesh's enclosed volume, mm³.
-    pub mesh_volume: f64,
+    /// For a part file: the TPMS level, or the strut radius (mm), of the solid sliced.
+    pub level: Option<f64>,
+    /// The mesh's enclosed volume, mm³ (none for an implicit part).
+    pub mesh_volume: Option<f64>,
     /// Σ area × thickness over the layers written, mm³ (the whole volume, unsharded: a check of
     /// the slices against the mesh).
     pub layer_volume: f64,
@@ -272,6 +277,20 @@ pub fn validate(opts: &SliceOptions) -> Result<()> {
     }
     if let Some(c) = &opts.csv {
         crate::io::atomic::check_writable(c)?;
+    }
+    if let Some(p) = &opts.plot {
+        if !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
+            return Err(Error::invalid(format!(
+                "{}: the plot is a PNG picture (name it .png)",
+                p.display()
+            )));
+        }
+        if opts.shard.is_some_and(|(_, n)| n > 1) {
+            return Err(Error::invalid(
+                "--plot covers the whole stack: leave it out of sharded runs",
+            ));
+        }
+        crate::io::atomic::check_writable(p)?;
     }
     Ok(())
 }
@@ -367,76 +386,129 @@ pub fn slice_mesh(
             }
         }
     };
-    let bounds = in_layer_bounds(mesh, &frame);
     let stack = Stack {
-        layers: layers.clone(),
-        bounds,
+        layers,
+        bounds: in_layer_bounds(mesh, &frame),
         heights: [lo, hi],
         frame,
         name: name.to_string(),
     };
-    let (first, end) = match opts.shard {
-        Some((k, n)) => (layers.len() * k / n, layers.len() * (k + 1) / n),
-        None => (0, layers.len()),
-    };
-    let sharded = opts.shard.is_some_and(|(_, n)| n > 1);
-    let mut writers: Vec<Box<dyn StackWriter>> = Vec::new();
-    if let Some(o) = &opts.output {
-        writers.push(o.writer(&stack, sharded)?);
-    }
-    if let Some(c) = &opts.csv {
-        writers.push(Box::new(super::csv::CsvWriter::create(c, &stack)?));
-    }
-    let zs: Vec<f64> = layers[first..end].iter().map(|l: &Layer| l.z).collect();
+    let (first, end) = shard_range(opts, stack.layers.len());
+    let zs: Vec<f64> = stack.layers[first..end].iter().map(|l| l.z).collect();
     let buckets = {
         let _s = progress.stage("bucketing facets");
         slicer.buckets(&zs)
     };
-    let mut out = SliceReport {
+    let tally = write_stack(&stack, opts, progress, |k| {
+        slicer.section(stack.layers[k].z, buckets.of(k - first))
+    })?;
+    Ok(SliceReport {
         input: name.to_string(),
         facets: mesh.triangle_count() as u64,
         self_intersecting: verified
             .self_intersection_checked
             .then_some(verified.self_intersecting),
         repairs,
-        direction: frame.d,
-        rule: opts.rule,
-        layers: layers.len(),
-        written: (first, end),
-        thickness: layers.iter().fold((f64::INFINITY, 0.0f64), |a, l| {
-            (a.0.min(l.thickness), a.1.max(l.thickness))
-        }),
-        heights: [lo, hi],
         segments: buckets.len() as u64,
-        loops: 0,
-        holes: 0,
-        open_chains: 0,
-        open_layers: Vec::new(),
-        mesh_volume: mesh.volume(),
-        layer_volume: 0.0,
-        outputs: opts
-            .output
-            .iter()
-            .map(|o| o.path().display().to_string())
-            .chain(opts.csv.iter().map(|c| c.display().to_string()))
-            .collect(),
+        mesh_volume: Some(mesh.volume()),
+        ..SliceReport::new(&stack, opts, tally)
+    })
+}
+
+/// The layers shard `opts.shard` writes, of `n`: `first..end`.
+fn shard_range(opts: &SliceOptions, n: usize) -> (usize, usize) {
+    match opts.shard {
+        Some((k, count)) => (n * k / count, n * (k + 1) / count),
+        None => (0, n),
+    }
+}
+
+/// What the layers written held.
+#[derive(Debug, Clone, Default)]
+struct Tally {
+    written: (usize, usize),
+    loops: u64,
+    holes: u64,
+    open_chains: u64,
+    open_layers: Vec<usize>,
+    layer_volume: f64,
+}
+
+impl SliceReport {
+    /// The report of `stack` sliced as `opts` asked, with what was found; the mesh's own
+    /// figures left empty.
+    fn new(stack: &Stack, opts: &SliceOptions, t: Tally) -> SliceReport {
+        SliceReport {
+            input: stack.name.clone(),
+            facets: 0,
+            self_intersecting: None,
+            repairs: Vec::new(),
+            direction: stack.frame.d,
+            rule: opts.rule,
+            layers: stack.layers.len(),
+            written: t.written,
+            thickness: stack.layers.iter().fold((f64::INFINITY, 0.0f64), |a, l| {
+                (a.0.min(l.thickness), a.1.max(l.thickness))
+            }),
+            heights: stack.heights,
+            segments: 0,
+            loops: t.loops,
+            holes: t.holes,
+            open_chains: t.open_chains,
+            open_layers: t.open_layers,
+            level: None,
+            mesh_volume: None,
+            layer_volume: t.layer_volume,
+            outputs: opts
+                .output
+                .iter()
+                .map(|o| o.path().display().to_string())
+                .chain(opts.csv.iter().map(|c| c.display().to_string()))
+                .chain(opts.plot.iter().map(|c| c.display().to_string()))
+                .collect(),
+        }
+    }
+}
+
+/// Cuts the layers of this shard with `section` (layer index → its section) a chunk at a time,
+/// in parallel, and streams them to the writers `opts` asks for.
+fn write_stack(
+    stack: &Stack,
+    opts: &SliceOptions,
+    progress: &Progress,
+    section: impl Fn(usize) -> Section + Sync,
+) -> Result<Tally> {
+    let layers = &stack.layers;
+    let (first, end) = shard_range(opts, layers.len());
+    let sharded = opts.shard.is_some_and(|(_, n)| n > 1);
+    let mut writers: Vec<Box<dyn StackWriter>> = Vec::new();
+    if let Some(o) = &opts.output {
+        writers.push(o.writer(stack, sharded)?);
+    }
+    if let Some(c) = &opts.csv {
+        writers.push(Box::new(super::csv::CsvWriter::create(c, stack)?));
+    }
+    let mut t = Tally {
+        written: (first, end),
+        ..Tally::default()
     };
+    let mut areas = Vec::new();
     let counter = progress.counter((end - first) as u64, "layers");
     for start in (first..end).step_by(CHUNK) {
         let stop = (start + CHUNK).min(end);
-        let sections: Vec<Section> = (start..stop)
-            .into_par_iter()
-            .map(|k| slicer.section(layers[k].z, buckets.of(k - first)))
-            .collect();
+        let sections: Vec<Section> = (start..stop).into_par_iter().map(&section).collect();
         for (k, s) in (start..stop).zip(&sections) {
             let m = s.measures();
-            out.loops += m.loops as u64;
-            out.holes += m.holes as u64;
-            out.open_chains += m.open as u64;
-            if m.open > 0 && out.open_layers.len() < 16 {
-                out.open_layers.push(k);
+            t.loops += m.loops as u64;
+            t.holes += m.holes as u64;
+            t.open_chains += m.open as u64;
+            if m.open > 0 && t.open_layers.len() < 16 {
+                t.open_layers.push(k);
             }
-            out.layer_volume += m.area * layers[k].thickness;
+            t.layer_volume += m.area * layers[k].thickness;
+            if opts.plot.is_some() {
+                areas.push(m.area);
+            }
         }
         for w in writers.iter_mut() {
             let encoded: Vec<Result<Vec<u8>>> = (start..stop)
@@ -453,13 +525,55 @@ pub fn slice_mesh(
         }
     }
     drop(counter);
-    {
-        let _s = progress.stage("writing");
-        for w in writers {
-            w.finish()?;
-        }
+    let _s = progress.stage("writing");
+    for w in writers {
+        w.finish()?;
     }
-    Ok(out)
+    if let Some(p) = &opts.plot {
+        super::plot::write_plot(p, layers, &areas)?;
+    }
+    Ok(t)
+}
+
+/// Slices an implicit solid — `field` negative inside, nothing outside `bounds` — sampled every
+/// `h` mm on each layer's plane (see [`super::implicit`]), named `name` in the files.
+pub fn slice_implicit(
+    field: &dyn Field,
+    bounds: &Aabb,
+    h: f64,
+    name: &str,
+    opts: &SliceOptions,
+    progress: &Progress,
+) -> Result<SliceReport> {
+    validate(opts)?;
+    if !(h > 0.0 && h.is_finite()) {
+        return Err(Error::invalid(format!(
+            "the sample spacing must be a positive length in mm, got {h}"
+        )));
+    }
+    if matches!(opts.rule, Rule::Cusp { .. }) {
+        return Err(Error::invalid(
+            "--adaptive cusp reads the slope of a mesh's facets: slice the meshed part, or use --adaptive area",
+        ));
+    }
+    let frame = Frame::new(opts.direction)?;
+    let (plane_bounds, heights) = super::implicit::project(bounds, &frame);
+    let slicer = ImplicitSlicer::new(field, bounds, frame, h);
+    let layers = {
+        let _s = progress.stage("placing layers");
+        plan(&opts.rule, heights[0], heights[1], &slicer)?
+    };
+    let stack = Stack {
+        layers,
+        bounds: plane_bounds,
+        heights,
+        frame,
+        name: name.to_string(),
+    };
+    let tally = write_stack(&stack, opts, progress, |k| {
+        slicer.section(stack.layers[k].z)
+    })?;
+    Ok(SliceReport::new(&stack, opts, tally))
 }
 
 /// The part's in-layer bounds, `[u_min, v_min, u_max, v_max]`.

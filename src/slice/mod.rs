@@ -4,16 +4,18 @@
 //! stair-step cusp); [`mesh`] cuts a triangle mesh at the layers' mid-heights, chaining segments
 //! through the mesh's own edges so a closed solid gives closed loops; [`contour`] measures loops
 //! and nests them into polygons with holes; [`raster`] turns them into anti-aliased masks; the
-//! writers ([`cli_file`], [`svg`], [`masks`], [`csv`]) write the stack; [`job`] runs it all, as
+//! writers ([`cli_file`], [`svg`], [`masks`], [`csv`], [`plot`]) write the stack; [`job`] runs it all, as
 //! `latvox slice` and batch jobs do.
 
 pub mod cli_file;
 pub mod contour;
 pub mod csv;
+pub mod implicit;
 pub mod job;
 pub mod masks;
 pub mod mesh;
 pub mod plan;
+pub mod plot;
 pub mod raster;
 pub mod svg;
 

@@ -205,6 +205,7 @@ impl StrutJob {
         };
         let c = self.domain.cell;
         Ok(crate::render::Model {
+            level: radius,
             solid: Box::new(StrutLattice {
                 cell: self.cell.clone(),
                 size: c,

@@ -97,22 +97,40 @@ impl TpmsReport {
 }
 
 impl TpmsJob {
-    /// The part as an implicit solid at the level the analytic model gives for the density.
+    /// The part as an implicit solid, at the level the part is meshed at.
     pub fn model(&self) -> Result<crate::render::Model> {
         self.validate()?;
         let bounds = self.domain.bounds();
         let cell = self.domain.cell;
         let min_cell = cell[0].min(cell[1]).min(cell[2]);
+        // The level the part is meshed at (calibrated for its partial cells and voxel), so the
+        // model is the solid the mesh approximates; the unit cell's own level if that fails.
+        let voxel = min_cell / self.resolution as f64;
+        let cal = calibrate::calibrate(
+            self.surface,
+            self.structure,
+            self.density,
+            cell,
+            voxel,
+            self.domain.counts(),
+            self.adaptivity,
+        )?;
+        let level = if cal.converged {
+            cal.level
+        } else {
+            cal.analytic_level
+        };
         Ok(crate::render::Model {
+            level,
             solid: Box::new(Lattice {
                 surface: self.surface,
                 structure: self.structure,
-                level: calibrate::analytic_level(self.surface, self.structure, self.density),
+                level,
                 cell,
                 bounds,
                 phase: bounds.min,
             }),
-            voxel: min_cell / self.resolution as f64,
+            voxel,
             cell: min_cell,
         })
     }
