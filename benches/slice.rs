@@ -10,7 +10,12 @@
 //! - linearity: gyroids of 4×4×2, 8×8×2 and 16×16×2 cells (1×, 4×, 16× the facets), 1,000
 //!   layers each.
 //!
-//! Run: `cargo bench --bench slice -- --runs 3` (`--quick` skips the 9.5 M-triangle part).
+//! - without a mesh: a 50 mm cube with a 1 mm skin filled with a gyroid (cells of 5 mm,
+//!   density 0.2) sliced from its part file into 1,000 PNG masks at 50 µm pixels, beside
+//!   `latvox fill` meshing it and the mesh sliced to the same masks.
+//!
+//! Run: `cargo bench --bench slice -- --runs 3` (`--quick` skips the 9.5 M-triangle part;
+//! `--implicit` runs only the part-file case).
 
 #[path = "../tests/common/child.rs"]
 mod child;
@@ -53,6 +58,7 @@ fn main() {
         .position(|a| a == "--runs")
         .map_or(3, |i| args[i + 1].parse().unwrap());
     let quick = args.iter().any(|a| a == "--quick");
+    let implicit_only = args.iter().any(|a| a == "--implicit");
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let peer = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/peers/trimesh_slice.py");
@@ -82,6 +88,9 @@ fn main() {
     let mut parts = vec![("g5x5x4.stl", "5,5,4", 20.0)];
     if !quick {
         parts.push(("g10.stl", "10", 50.0));
+    }
+    if implicit_only {
+        parts.clear();
     }
     for &(name, cells, height) in &parts {
         make(name, cells);
@@ -152,7 +161,12 @@ fn main() {
             );
         }
     }
-    for (k, cells) in [(1, "4,4,2"), (4, "8,8,2"), (16, "16,16,2")] {
+    let lin: &[(u32, &str)] = if implicit_only {
+        &[]
+    } else {
+        &[(1, "4,4,2"), (4, "8,8,2"), (16, "16,16,2")]
+    };
+    for &(k, cells) in lin {
         let name = format!("lin{k}.stl");
         make(&name, cells);
         let (s, m) = measure(runs, || {
@@ -166,4 +180,58 @@ fn main() {
             format!("gyroid {cells} cells ({k}× facets): 1,000 layers")
         );
     }
+    // Without a mesh: the filled cube's part file sliced to 1,000 masks; then meshed and sliced.
+    let cube: Vec<u8> = {
+        let (lo, hi) = ([0.0f32; 3], [50.0f32; 3]);
+        let m = latvox::mesh::Mesh::cuboid(lo, hi);
+        let mut b = vec![0u8; 80];
+        b.extend((m.triangle_count() as u32).to_le_bytes());
+        for t in m.indices.chunks_exact(3) {
+            b.extend([0u8; 12]);
+            for &v in t {
+                for a in 0..3 {
+                    b.extend(m.positions[3 * v as usize + a].to_le_bytes());
+                }
+            }
+            b.extend([0u8; 2]);
+        }
+        b
+    };
+    std::fs::write(d.join("cube.stl"), cube).unwrap();
+    std::fs::write(
+        d.join("cube.toml"),
+        "command = \"fill\"\ninput = \"cube.stl\"\nskin = 1\nlattice = \"gyroid\"\ncell-size = 5\ndensity = 0.2\n",
+    )
+    .unwrap();
+    let masks = ["-o", "masks/", "--pixel", "0.05", "--layer", "0.05"];
+    let with = |head: &[&'static str]| -> Vec<String> {
+        head.iter()
+            .chain(masks.iter())
+            .map(|s| s.to_string())
+            .collect()
+    };
+    let implicit = with(&["-q", "slice", "cube.toml"]);
+    let (s, m) = measure(1, || {
+        latvox(d, &implicit.iter().map(String::as_str).collect::<Vec<_>>())
+    });
+    println!(
+        "{:<48} {s:>9.2} {m:>6.0}   (1 run)",
+        "filled 50 mm cube: part file → 1,000 PNG masks"
+    );
+    let (s1, m1) = measure(1, || {
+        latvox(
+            d,
+            &["-q", "fill", "--part", "cube.toml", "-o", "cube-filled.stl"],
+        )
+    });
+    let meshed = with(&["-q", "slice", "cube-filled.stl"]);
+    let (s2, m2) = measure(1, || {
+        latvox(d, &meshed.iter().map(String::as_str).collect::<Vec<_>>())
+    });
+    println!(
+        "{:<48} {:>9.2} {:>6.0}   (fill {s1:.2} s + slice {s2:.2} s, 1 run)",
+        "filled 50 mm cube: meshed, then 1,000 PNG masks",
+        s1 + s2,
+        m1.max(m2)
+    );
 }

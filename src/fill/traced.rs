@@ -152,14 +152,14 @@ impl Field for FilledScene<'_> {
 
     fn value_and_clearance(&self, p: Vec3) -> (f64, f64) {
         let t = self.traced;
-        let cap = t.skin + t.blend + t.reach() + t.voxel;
-        let surface = t.part.distance(p, cap);
+        let surface = self.depth(p);
         let (v, c) = if t.part.contains(p) {
-            let (v, c) = self.inside(p);
+            let (v, c) = self.inside_at(p, surface);
             (v, c.min(surface))
         } else {
             (surface.max(1e-12), surface)
         };
+        let cap = t.skin + t.blend + t.reach() + t.voxel;
         t.keep.iter().fold((v, c), |(v, c), k| {
             let d = k.distance(p, cap);
             let dk = if k.contains(p) { -d } else { d };
@@ -185,9 +185,18 @@ impl FilledScene<'_> {
     /// The solid inside the part at `x` (the skin or the lattice, less the drain holes): value
     /// and clearance.
     fn inside(&self, x: Vec3) -> (f64, f64) {
-        let t = self.traced;
         // Without a skin the lattice alone fills the part, whatever the depth.
-        let d = if t.skin > 0.0 { self.depth(x) } else { 0.0 };
+        let d = if self.traced.skin > 0.0 {
+            self.depth(x)
+        } else {
+            0.0
+        };
+        self.inside_at(x, d)
+    }
+
+    /// [`FilledScene::inside`] at `x`, `d` its (capped) depth in the part.
+    fn inside_at(&self, x: Vec3, d: f64) -> (f64, f64) {
+        let t = self.traced;
         let core = d - t.skin;
         let (v, c) = skin_or_lattice(
             (core, core.abs()),

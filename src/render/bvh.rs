@@ -111,7 +111,7 @@ impl Bvh {
             return None;
         }
         // Nodes to visit, with the distance at which the ray enters them.
-        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        let mut stack = Stack::<(u32, f64)>::new();
         stack.push((0, 0.0));
         while let Some((i, t_in)) = stack.pop() {
             // Entered beyond the nearest hit found since it was pushed: nothing nearer inside.
@@ -169,7 +169,7 @@ impl Bvh {
         let Some(root) = self.nodes.first() else {
             return limit;
         };
-        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        let mut stack = Stack::<(u32, f64)>::new();
         stack.push((0, box_distance2(&root.bounds, p)));
         while let Some((i, d2)) = stack.pop() {
             if d2 >= best2 {
@@ -211,7 +211,8 @@ impl Bvh {
         if ray.clip(&root.bounds).is_none() {
             return false;
         }
-        let mut stack = vec![0u32];
+        let mut stack = Stack::<u32>::new();
+        stack.push(0);
         while let Some(i) = stack.pop() {
             let node = &self.nodes[i as usize];
             if node.count > 0 {
@@ -229,6 +230,42 @@ impl Bvh {
             }
         }
         crossings % 2 == 1
+    }
+}
+
+/// A traversal stack: 64 entries in place (no allocation per query), more on the heap.
+struct Stack<T> {
+    inline: [T; 64],
+    len: usize,
+    spill: Vec<T>,
+}
+
+impl<T: Copy + Default> Stack<T> {
+    fn new() -> Self {
+        Stack {
+            inline: [T::default(); 64],
+            len: 0,
+            spill: Vec::new(),
+        }
+    }
+
+    fn push(&mut self, x: T) {
+        if self.len < self.inline.len() {
+            self.inline[self.len] = x;
+            self.len += 1;
+        } else {
+            self.spill.push(x);
+        }
+    }
+
+    fn pop(&mut self) -> Option<T> {
+        if let Some(x) = self.spill.pop() {
+            return Some(x);
+        }
+        (self.len > 0).then(|| {
+            self.len -= 1;
+            self.inline[self.len]
+        })
     }
 }
 
@@ -496,5 +533,22 @@ mod tests {
         assert!(bvh.contains([5.0, 5.0, 5.0]) && bvh.contains([0.1, 9.9, 5.0]));
         assert!(!bvh.contains([11.0, 5.0, 5.0]) && !bvh.contains([-0.1, 5.0, 5.0]));
         assert!((bvh.distance([5.0, 5.0, 4.0], 100.0) - 4.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_traversal_stack_is_last_in_first_out_past_its_inline_part() {
+        let mut s = Stack::<u32>::new();
+        for i in 0..200 {
+            s.push(i);
+        }
+        for i in (150..200).rev() {
+            assert_eq!(s.pop(), Some(i));
+        }
+        s.push(7);
+        assert_eq!(s.pop(), Some(7));
+        for i in (0..150).rev() {
+            assert_eq!(s.pop(), Some(i));
+        }
+        assert_eq!(s.pop(), None);
     }
 }

@@ -105,16 +105,7 @@ impl TpmsJob {
         let min_cell = cell[0].min(cell[1]).min(cell[2]);
         // The level the part is meshed at (calibrated for its partial cells and voxel), so the
         // model is the solid the mesh approximates; the unit cell's own level if that fails.
-        let voxel = min_cell / self.resolution as f64;
-        let cal = calibrate::calibrate(
-            self.surface,
-            self.structure,
-            self.density,
-            cell,
-            voxel,
-            self.domain.counts(),
-            self.adaptivity,
-        )?;
+        let (cal, voxel) = self.calibration(self.resolution)?;
         let level = if cal.converged {
             cal.level
         } else {
@@ -287,6 +278,23 @@ impl TpmsJob {
         })
     }
 
+    /// The level calibrated for this part at `resolution` voxels per (shortest) cell, and that
+    /// voxel's size.
+    fn calibration(&self, resolution: u32) -> Result<(calibrate::Calibration, f64)> {
+        let cell = self.domain.cell;
+        let voxel = cell.iter().cloned().fold(f64::INFINITY, f64::min) / resolution as f64;
+        let cal = calibrate::calibrate(
+            self.surface,
+            self.structure,
+            self.density,
+            cell,
+            voxel,
+            self.domain.counts(),
+            self.adaptivity,
+        )?;
+        Ok((cal, voxel))
+    }
+
     /// Calibrates a first level at `resolution` and searches the level for the part from it:
     /// the part found, or the closest fraction when no level on these voxels gives the target
     /// (the unit cell's calibration not converging is enough to tell, without meshing the
@@ -297,17 +305,7 @@ impl TpmsJob {
         opts: &Options,
     ) -> Result<(f64, std::result::Result<Found, f64>)> {
         let cell = self.domain.cell;
-        let min_cell = cell.iter().cloned().fold(f64::INFINITY, f64::min);
-        let voxel = min_cell / resolution as f64;
-        let cal = calibrate::calibrate(
-            self.surface,
-            self.structure,
-            self.density,
-            cell,
-            voxel,
-            self.domain.counts(),
-            self.adaptivity,
-        )?;
+        let (cal, voxel) = self.calibration(resolution)?;
         if !cal.converged {
             return Ok((cal.seconds, Err(cal.predicted_fraction)));
         }
