@@ -64,8 +64,9 @@ enum Command {
     /// it, or of a mesh file, ray cast.
     #[command(after_help = cli::render::EXAMPLES)]
     Render(cli::render::RenderArgs),
-    /// Slice a mesh file into layers for printing: CLI (Common Layer Interface), SVG, PNG
-    /// masks, SL1; uniform or adaptive layers, any build direction.
+    /// Slice a mesh file, or a part file without meshing it, into layers for printing: CLI
+    /// (Common Layer Interface), SVG, PNG masks, SL1; uniform or adaptive layers, any build
+    /// direction.
     #[command(after_help = cli::slice::EXAMPLES)]
     Slice(cli::slice::SliceArgs),
     /// Run many jobs from a TOML job file: sweeps, workers, resume after a kill, Slurm arrays.

@@ -475,6 +475,20 @@ fn masks_stacks_archives_and_shards_hold_the_layers() {
             y.display()
         );
     }
+    // The layer plot: a picture with the thickness and area curves drawn in colour.
+    ok(d, "slice torus.stl --plot plot.png --adaptive area");
+    let dec = png::Decoder::new(std::io::Cursor::new(
+        std::fs::read(d.join("plot.png")).unwrap(),
+    ));
+    let mut r = dec.read_info().unwrap();
+    let mut buf = vec![0; r.output_buffer_size().unwrap()];
+    let info = r.next_frame(&mut buf).unwrap();
+    assert_eq!((info.width, info.height), (960, 640));
+    let coloured = buf[..info.buffer_size()]
+        .chunks_exact(3)
+        .filter(|p| p[0].abs_diff(p[2]) > 100)
+        .count();
+    assert!(coloured > 500, "{coloured} coloured pixels");
     // An SVG stack: one group per layer, one path per polygon.
     ok(d, "slice torus.stl -o t.svg --layer 0.4");
     let svg = std::fs::read_to_string(d.join("t.svg")).unwrap();
@@ -491,6 +505,11 @@ fn open_meshes_are_refused_or_repaired_and_bad_settings_refused() {
     tris.remove(100);
     meshkit::write_stl(&d.join("open.stl"), &tris);
     meshkit::write_stl(&d.join("ball.stl"), &meshkit::sphere(5.0, 24));
+    std::fs::write(
+        d.join("g.toml"),
+        "command = \"tpms\"\ntype = \"gyroid\"\ncells = 2\ncell-size = 5\n",
+    )
+    .unwrap();
     let before = files_in(d);
     for (args, what) in [
         (
@@ -543,6 +562,15 @@ fn open_meshes_are_refused_or_repaired_and_bad_settings_refused() {
         ),
         (vec!["slice", "ball.stl"], "nothing to write"),
         (vec!["slice", "missing.stl", "-o", "out.cli"], "missing.stl"),
+        (vec!["slice", "ball.stl", "--plot", "p.jpg"], "PNG picture"),
+        (
+            vec!["slice", "ball.stl", "-o", "out.cli", "--sample", "0.1"],
+            "part files",
+        ),
+        (
+            vec!["slice", "g.toml", "-o", "out.cli", "--adaptive", "cusp"],
+            "mesh",
+        ),
     ] {
         let out = run(&args, d);
         assert_refusal(d, &before, &out, &args, what);

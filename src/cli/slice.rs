@@ -23,6 +23,7 @@ Examples:
       --min-layer 0.025 --max-layer 0.2                      # adaptive layers, plotted
   latvox slice part.stl --csv p.csv --adaptive cusp --cusp 0.01
   latvox slice scan.stl -o scan.cli --repair                 # mend an open mesh in memory first
+  latvox slice octet.toml -o octet.cli                       # a part file, sliced without a mesh
   latvox slice big.stl -o layers/ --shard 3/8                # one task of a Slurm array
 
 The mesh is checked first: one that is not a closed, outward solid (holes, non-manifold or
@@ -32,6 +33,10 @@ segments are chained into loops through the mesh's own edges (Minetto et al., Co
 Design 2017), so a closed solid gives closed loops: outer loops counter-clockwise, holes
 clockwise, seen from +direction. In-layer coordinates are x and y for the default +Z build; for
 another direction they are two axes across it (stack.json and the JSON report name them).
+
+A part file (.toml, from `latvox tpms|strut|fill --save-part`) is sliced from its implicit solid:
+the field is sampled on each layer's plane (every --sample mm, only near the surface) and
+contoured by marching squares; nothing is meshed, and a box's sharp cut faces stay sharp.
 
 Outputs by name: .cli (CLI v2.0; z of a layer is its top), .svg (one group per layer), .sl1
 (Original Prusa SL1 display, uniform layers only), or a folder (name ending in /, or no
@@ -62,10 +67,6 @@ pub struct SliceArgs {
     /// a part file is sliced from its implicit solid, never meshed.
     #[arg(value_name = "MESH|PART")]
     pub input: PathBuf,
-    /// Sample spacing on each layer for a part file, mm (default: a quarter of the voxel the
-    /// part would be meshed at, and no coarser than --pixel for masks).
-    #[arg(long, value_name = "MM", value_parser = super::parse_positive)]
-    pub sample: Option<f64>,
     /// Output: FILE.cli, FILE.svg, FILE.sl1, or a folder (DIR/) of PNG or SVG layers.
     #[arg(short, long, value_name = "PATH")]
     pub output: Option<PathBuf>,
@@ -99,6 +100,10 @@ pub struct SliceArgs {
     /// Pixel size of PNG masks, mm (folder output).
     #[arg(long, value_name = "MM", default_value_t = 0.05, value_parser = super::parse_positive)]
     pub pixel: f64,
+    /// Sample spacing on each layer for a part file, mm (default: a quarter of the voxel the
+    /// part would be meshed at, and no coarser than --pixel for masks).
+    #[arg(long, value_name = "MM", value_parser = super::parse_positive)]
+    pub sample: Option<f64>,
     /// What a folder output holds.
     #[arg(long, value_enum, default_value = "png")]
     pub format: FolderFormat,

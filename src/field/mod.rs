@@ -35,6 +35,15 @@ pub trait Field: Sync {
         (self.value(p), numeric_gradient(|q| self.value(q), p))
     }
 
+    /// Values at `points` (a small, compact set: a block of samples), into `out`. Fields whose
+    /// work can be shared across nearby points (a test done once for the whole block) override
+    /// it.
+    fn values(&self, points: &[Vec3], out: &mut [f64]) {
+        for (p, o) in points.iter().zip(out.iter_mut()) {
+            *o = self.value(*p);
+        }
+    }
+
     /// Values at the 8³ points `origin + h·(i, j, k)`, `i, j, k ∈ 0..8`, stored at
     /// `out[(i·8 + j)·8 + k]` (OpenVDB's leaf order). Fields with separable structure override
     /// this to share work along each axis.
@@ -69,6 +78,9 @@ impl<T: Field + ?Sized> Field for &T {
     }
     fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
         (**self).sample_block(origin, h, out)
+    }
+    fn values(&self, points: &[Vec3], out: &mut [f64]) {
+        (**self).values(points, out)
     }
 }
 

@@ -13,6 +13,7 @@ use crate::error::Result;
 use crate::field::{intersection_clearance, union_clearance, Aabb, Field, Vec3};
 use crate::grid::GridSpec;
 use crate::mesh::pipeline::Solid;
+use crate::mesh::{norm, sub};
 use crate::render::bvh::Bvh;
 use crate::render::camera::{dot, Ray};
 use crate::render::trace::{
@@ -148,6 +149,37 @@ impl Field for FilledScene<'_> {
 
     fn clearance(&self, p: Vec3) -> f64 {
         self.value_and_clearance(p).1
+    }
+
+    /// A block of points shares its tests: when the part's surface is farther from the block's
+    /// centre than the block reaches, one parity test places the whole block, and where it is
+    /// deeper inside than the skin and lattice look, no point asks for its depth.
+    fn values(&self, points: &[Vec3], out: &mut [f64]) {
+        let t = self.traced;
+        let n = points.len() as f64;
+        let c = points
+            .iter()
+            .fold([0.0; 3], |a, p| [0, 1, 2].map(|k| a[k] + p[k] / n));
+        let reach = points.iter().map(|p| norm(sub(*p, c))).fold(0.0, f64::max);
+        let cap = t.skin + t.blend + t.reach() + t.voxel;
+        let d = t.part.distance(c, cap + reach);
+        if !t.keep.is_empty() || d <= reach {
+            for (p, o) in points.iter().zip(out.iter_mut()) {
+                *o = self.value(*p);
+            }
+            return;
+        }
+        let inside = t.part.contains(c);
+        for (p, o) in points.iter().zip(out.iter_mut()) {
+            let lower = d - norm(sub(*p, c));
+            *o = if !inside {
+                lower.max(1e-12)
+            } else if lower >= cap {
+                self.inside_at(*p, cap).0
+            } else {
+                self.inside_at(*p, self.depth(*p)).0
+            };
+        }
     }
 
     fn value_and_clearance(&self, p: Vec3) -> (f64, f64) {

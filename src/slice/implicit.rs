@@ -45,12 +45,17 @@ impl<'a> ImplicitSlicer<'a> {
     /// The clipped solid's value and clearance at `p`: the field's, cut by the box (whose
     /// slab distance is exact inside and a lower bound outside).
     fn sample(&self, p: Vec3) -> (f64, f64) {
-        let b = &self.clip;
-        let bv = (0..3)
-            .map(|a| (b.min[a] - p[a]).max(p[a] - b.max[a]))
-            .fold(f64::NEG_INFINITY, f64::max);
+        let bv = self.box_value(p);
         let (v, c) = self.field.value_and_clearance(p);
         (v.max(bv), intersection_clearance(v, c, bv, bv.abs()))
+    }
+
+    /// The clipping box's slab distance at `p` (negative inside).
+    fn box_value(&self, p: Vec3) -> f64 {
+        let b = &self.clip;
+        (0..3)
+            .map(|a| (b.min[a] - p[a]).max(p[a] - b.max[a]))
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// The section at height `z`.
@@ -89,11 +94,24 @@ impl<'a> ImplicitSlicer<'a> {
                 }
             }
         }
-        // Blocks near the surface: every sample (shared edges evaluated again, exactly).
+        // Blocks near the surface: every sample (shared edges evaluated again, exactly), the
+        // block's points given to the field at once.
+        let mut points = Vec::with_capacity((BLOCK + 1) * (BLOCK + 1));
+        let mut out = Vec::with_capacity((BLOCK + 1) * (BLOCK + 1));
         for (i0, j0, i1, j1) in near {
+            points.clear();
             for j in j0..=j1 {
                 for i in i0..=i1 {
-                    vals[j * nu + i] = self.sample(at(i as f64, j as f64)).0;
+                    points.push(at(i as f64, j as f64));
+                }
+            }
+            out.resize(points.len(), 0.0);
+            self.field.values(&points, &mut out);
+            let mut k = 0;
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    vals[j * nu + i] = out[k].max(self.box_value(points[k]));
+                    k += 1;
                 }
             }
         }

@@ -267,9 +267,9 @@ pub fn validate(opts: &SliceOptions) -> Result<()> {
             )));
         }
     }
-    if opts.output.is_none() && opts.csv.is_none() {
+    if opts.output.is_none() && opts.csv.is_none() && opts.plot.is_none() {
         return Err(Error::invalid(
-            "nothing to write: give -o FILE (or a folder) and/or --csv FILE.csv",
+            "nothing to write: give -o FILE (or a folder), --csv FILE.csv or --plot FILE.png",
         ));
     }
     if let Some(o) = &opts.output {
