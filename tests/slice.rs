@@ -443,6 +443,18 @@ fn masks_stacks_archives_and_shards_hold_the_layers() {
         "{config}"
     );
     assert!(config.contains("layerHeight = 0.4"), "{config}");
+    // The resin used, ml: Σ area × thickness of the layers.
+    let used: f64 = config
+        .lines()
+        .find_map(|l| l.strip_prefix("usedMaterial = "))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let resin: f64 = rows.iter().map(|r| r[2] * r[1]).sum::<f64>() / 1000.0;
+    assert!(
+        (used - resin).abs() < 1e-3 * resin + 1e-3,
+        "{used} ml vs {resin} ml"
+    );
     let names: Vec<String> = zip.file_names().map(|n| n.unwrap().into_owned()).collect();
     assert_eq!(
         names

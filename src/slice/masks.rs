@@ -215,6 +215,13 @@ impl StackWriter for PngDirWriter {
 /// The Original Prusa SL1's display: pixels across, pixels along, pixel size (mm).
 pub const SL1_DISPLAY: (usize, usize, f64) = (1440, 2560, 0.046875);
 
+/// Exposure of a layer, and of the first (fading) layers, s; the tilt after each layer, s.
+const EXPOSURE: f64 = 6.0;
+const EXPOSURE_FIRST: f64 = 20.0;
+const TILT: f64 = 5.0;
+/// Layers whose exposure fades from the first layers' to the others'.
+const FADE: usize = 10;
+
 /// Thumbnail size in an SL1 archive.
 const THUMB: usize = 400;
 
@@ -226,6 +233,8 @@ pub struct Sl1Writer {
     grid: PixelGrid,
     thumb_grid: PixelGrid,
     thumb: Vec<u8>,
+    /// Resin used so far, mm³.
+    material: f64,
     job: String,
     stack: Stack,
 }
@@ -277,6 +286,7 @@ impl Sl1Writer {
             grid,
             thumb_grid,
             thumb: vec![0; THUMB * THUMB],
+            material: 0.0,
             job: if job.is_empty() { "part".into() } else { job },
             stack: stack.clone(),
         })
@@ -287,31 +297,39 @@ impl Sl1Writer {
         let t = self.stack.layers.first().map_or(0.05, |l| l.thickness);
         let stamp = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
         format!(
-            "action = print\njobDir = {}\nexpTime = 6\nexpTimeFirst = 20\nfileCreationTimestamp = {}\n\
+            "action = print\njobDir = {}\nexpTime = {EXPOSURE}\nexpTimeFirst = {EXPOSURE_FIRST}\n\
+             fileCreationTimestamp = {}\n\
              hollow = 0\nlayerHeight = {t}\nmaterialName = Generic\nnumFade = {}\nnumFast = {n}\n\
              numSlow = 0\nprintProfile = latvox {t} mm\nprintTime = {:.0}\nprinterModel = SL1\n\
              printerProfile = Original Prusa SL1\nprinterVariant = default\n\
              prusaSlicerVersion = latvox-{}\nusedMaterial = {:.3}\n",
             self.job,
             stamp.replace('T', " at ").replace('Z', " UTC"),
-            n.min(10),
-            n as f64 * 8.0,
+            FADE.min(n),
+            // An estimate: the exposures, and the SL1's fast tilt (about 5 s) after each layer.
+            EXPOSURE_FIRST * FADE.min(n) as f64 + (EXPOSURE + TILT) * n as f64
+                - EXPOSURE * FADE.min(n) as f64,
             env!("CARGO_PKG_VERSION"),
-            0.0
+            self.material / 1000.0
         )
     }
 }
 
 impl StackWriter for Sl1Writer {
-    /// The layer's PNG, then the layer's thumbnail coverage (THUMB² bytes) appended.
+    /// The layer's PNG, then the layer's thumbnail coverage (THUMB² bytes) and its area (mm²,
+    /// f64) appended.
     fn encode(&self, _index: usize, section: &Section) -> Result<Vec<u8>> {
         let g = self.grid;
         let mut out = encode_grey(g.width as u32, g.height as u32, &g.mask(section).grey())?;
         out.extend(self.thumb_grid.mask(section).grey());
+        out.extend(section.measures().area.to_le_bytes());
         Ok(out)
     }
 
     fn put(&mut self, index: usize, mut encoded: Vec<u8>) -> Result<()> {
+        let area = encoded.split_off(encoded.len() - 8);
+        let area = f64::from_le_bytes(area.try_into().expect("8 bytes"));
+        self.material += area * self.stack.layers[index].thickness;
         let thumb = encoded.split_off(encoded.len() - THUMB * THUMB);
         for (a, b) in self.thumb.iter_mut().zip(thumb) {
             *a = (*a).max(b);
