@@ -583,6 +583,10 @@ fn open_meshes_are_refused_or_repaired_and_bad_settings_refused() {
             vec!["slice", "g.toml", "-o", "out.cli", "--adaptive", "cusp"],
             "mesh",
         ),
+        (
+            vec!["slice", "g.toml", "-o", "out.cli", "--sample", "1e-6"],
+            "larger --sample",
+        ),
     ] {
         let out = run(&args, d);
         assert_refusal(d, &before, &out, &args, what);

@@ -16,6 +16,9 @@ use crate::field::{intersection_clearance, Aabb, Field, Vec3};
 /// Samples per block side.
 const BLOCK: usize = 8;
 
+/// Most samples one layer's plane may hold (1.6 GB of values).
+pub const MAX_SAMPLES: f64 = 2e8;
+
 /// An implicit solid prepared for slicing along one direction.
 pub struct ImplicitSlicer<'a> {
     field: &'a dyn Field,
@@ -40,6 +43,12 @@ impl<'a> ImplicitSlicer<'a> {
             bounds: b,
             h,
         }
+    }
+
+    /// Samples on one layer's plane (the grid and its margin).
+    pub fn samples_per_layer(&self) -> f64 {
+        let b = self.bounds;
+        (((b[2] - b[0]) / self.h).ceil() + 3.0) * (((b[3] - b[1]) / self.h).ceil() + 3.0)
     }
 
     /// The clipped solid's value and clearance at `p`: the field's, cut by the box (whose

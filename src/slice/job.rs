@@ -559,6 +559,13 @@ pub fn slice_implicit(
     let frame = Frame::new(opts.direction)?;
     let (plane_bounds, heights) = super::implicit::project(bounds, &frame);
     let slicer = ImplicitSlicer::new(field, bounds, frame, h);
+    let n = slicer.samples_per_layer();
+    if n > super::implicit::MAX_SAMPLES || n.is_nan() {
+        return Err(Error::invalid(format!(
+            "{h} mm samples make {n:.3e} samples a layer (more than {:.0e}): use a larger --sample",
+            super::implicit::MAX_SAMPLES
+        )));
+    }
     let layers = {
         let _s = progress.stage("placing layers");
         plan(&opts.rule, heights[0], heights[1], &slicer)?
