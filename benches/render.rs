@@ -17,7 +17,7 @@ mod support;
 
 use child::run_measured;
 use std::path::Path;
-use support::latvox;
+use support::{latvox, median, runs_arg};
 
 /// Median seconds and median peak memory (MB) of `runs` runs of each command in turn (one
 /// process after another; the case's time is their sum).
@@ -35,19 +35,12 @@ fn measure(dir: &Path, runs: usize, steps: &[&[&str]]) -> (f64, f64) {
         secs.push(s);
         mem.push(m);
     }
-    let median = |v: &mut Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
-    (median(&mut secs), median(&mut mem))
+    (median(secs), median(mem))
 }
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let runs: usize = args
-        .iter()
-        .position(|a| a == "--runs")
-        .map_or(3, |i| args[i + 1].parse().unwrap());
+    let runs = runs_arg(&args, 3);
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     for n in [10, 100] {

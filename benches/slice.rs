@@ -24,12 +24,7 @@ mod support;
 use child::run_measured;
 use std::path::Path;
 use std::process::{Command, Stdio};
-use support::latvox;
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
+use support::{latvox, median, runs_arg};
 
 /// Median seconds and peak MB of `runs` runs of `make()`.
 fn measure(runs: usize, mut make: impl FnMut() -> Command) -> (f64, f64) {
@@ -53,10 +48,7 @@ fn have(cmd: &str) -> bool {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let runs: usize = args
-        .iter()
-        .position(|a| a == "--runs")
-        .map_or(3, |i| args[i + 1].parse().unwrap());
+    let runs = runs_arg(&args, 3);
     let quick = args.iter().any(|a| a == "--quick");
     let implicit_only = args.iter().any(|a| a == "--implicit");
     let dir = tempfile::tempdir().unwrap();

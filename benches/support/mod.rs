@@ -1,6 +1,6 @@
 //! What the benchmarks share: the process's peak memory, a sink that makes STL records and
 //! drops them (the writing of a part too large for this machine's disk, without the disk),
-//! a torus mesh, and latvox as a quiet child process.
+//! a torus mesh, latvox as a quiet child process, medians and the `--runs` argument.
 #![allow(dead_code)]
 
 use latvox::io::sink::{MeshSink, Triangle};
@@ -88,4 +88,17 @@ pub fn latvox(dir: &std::path::Path, args: &[&str]) -> std::process::Command {
         .stdout(Stdio::null())
         .stderr(Stdio::null());
     c
+}
+
+/// The middle value of `v` (the upper one of an even count).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// `--runs N` from the bench's arguments (`default` without it).
+pub fn runs_arg(args: &[String], default: usize) -> usize {
+    args.iter()
+        .position(|a| a == "--runs")
+        .map_or(default, |i| args[i + 1].parse().expect("--runs N"))
 }
