@@ -17,6 +17,8 @@ PKGS=(
   slurm-wlm munge
   # mesh check/repair tests: CGAL's data archive of broken meshes; pip for trimesh
   libcgal-demo python3-pip
+  # browser editor tests (latvox view): headless Chromium, driven through Playwright
+  chromium
 )
 
 if [ "$(id -u)" -eq 0 ]; then SUDO=(); else SUDO=(sudo); fi
@@ -37,10 +39,11 @@ fi
 
 # Python packages for the tests: NumPy/SciPy (reference optimisers, independent checks of the
 # cleaned fields), gmsh (OpenCASCADE reads the IGES back), ezdxf (reads the DXF back),
-# trimesh with networkx and lxml (an independent mesh analyser for check/repair), and shapely
-# (checks every slice layer's polygons).
-PY_PKGS=(numpy scipy gmsh ezdxf trimesh networkx lxml lib3mf shapely)
-PY_IMPORTS="import numpy, scipy, gmsh, ezdxf, trimesh, networkx, lxml, lib3mf, shapely"
+# trimesh with networkx and lxml (an independent mesh analyser for check/repair), shapely
+# (checks every slice layer's polygons), and Playwright (drives Debian's Chromium through the
+# browser editor's page; it uses that browser and downloads none of its own).
+PY_PKGS=(numpy scipy gmsh ezdxf trimesh networkx lxml lib3mf shapely playwright)
+PY_IMPORTS="import numpy, scipy, gmsh, ezdxf, trimesh, networkx, lxml, lib3mf, shapely, playwright"
 if python3 -c "$PY_IMPORTS" 2>/dev/null; then
   echo "install-deps: Python packages present" >&2
 else

@@ -64,6 +64,10 @@ enum Command {
     /// it, or of a mesh file, ray cast.
     #[command(after_help = cli::render::EXAMPLES)]
     Render(cli::render::RenderArgs),
+    /// Edit a part file live in the browser: a local server whose page sphere-traces the part
+    /// on the GPU (no mesh), with controls, sections, saving, meshing and slicing.
+    #[command(after_help = cli::view::EXAMPLES)]
+    View(cli::view::ViewArgs),
     /// Slice a mesh file, or a part file without meshing it, into layers for printing: CLI
     /// (Common Layer Interface), SVG, PNG masks, SL1; uniform or adaptive layers, any build
     /// direction.
@@ -168,6 +172,7 @@ fn main() {
         Command::Topo(a) => cli::topo::run(a, cli.quiet),
         Command::Batch(a) => cli::batch::run(a, cli.quiet),
         Command::Render(a) => cli::render::run(a),
+        Command::View(a) => cli::view::run(a),
         Command::Slice(a) => cli::slice::run(a, cli.quiet),
     };
     let result = result.and_then(|code| {

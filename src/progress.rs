@@ -1,6 +1,8 @@
 //! Progress on long steps: a spinner on stderr for any stage that lasts over a second, only when
 //! stderr is a terminal and the user did not ask for quiet. Pipes and logs stay clean.
-//! Work made of many items (the jobs of a batch) gets a counting bar instead.
+//! Work made of many items (the jobs of a batch) gets a counting bar instead. With
+//! `LATVOX_PROGRESS=lines` in the environment each stage is a line `progress: NAME` on stderr
+//! instead, for a program that runs latvox and shows its progress (the browser editor).
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -11,25 +13,34 @@ use std::time::Duration;
 #[derive(Debug, Clone, Copy)]
 pub struct Progress {
     enabled: bool,
+    lines: bool,
 }
 
 impl Progress {
     /// Spinners on stderr if it is a terminal and `quiet` is false.
     pub fn new(quiet: bool) -> Self {
+        let lines = std::env::var("LATVOX_PROGRESS").is_ok_and(|v| v == "lines");
         Progress {
-            enabled: !quiet && std::io::stderr().is_terminal(),
+            enabled: !quiet && (lines || std::io::stderr().is_terminal()),
+            lines,
         }
     }
 
     /// No progress shown (library use, tests, batch workers).
     pub fn hidden() -> Self {
-        Progress { enabled: false }
+        Progress {
+            enabled: false,
+            lines: false,
+        }
     }
 
     /// Starts a stage; its spinner appears once the stage has run for a second, and disappears
     /// when the returned guard is dropped.
     pub fn stage(&self, name: &str) -> Stage {
-        if !self.enabled {
+        if !self.enabled || self.lines {
+            if self.enabled {
+                eprintln!("progress: {name}");
+            }
             return Stage {
                 done: None,
                 thread: None,

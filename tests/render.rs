@@ -7,10 +7,9 @@
 mod common;
 mod meshkit;
 use common::*;
-use latvox::mesh::pipeline::Solid;
 use latvox::render::camera::Ray;
 use latvox::render::trace::{Implicit, Tolerance};
-use latvox::render::Model;
+use latvox::render::{Model, Periodic};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -94,23 +93,6 @@ fn compare(dir: &Path, view: &str, extra: &[&str], distance: f64, voxel: f64) ->
     )
 }
 
-/// Runs latvox with `args` in `dir`, asserting success.
-fn ok(args: &[&str], dir: &Path) {
-    let r = run(args, dir);
-    assert_eq!(
-        r.status.code(),
-        Some(0),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&r.stderr)
-    );
-}
-
-fn make(dir: &Path, args: &[&str]) {
-    let mut all = args.to_vec();
-    all.extend(["-q", "-o", "part.stl", "--save-part", "part.toml"]);
-    ok(&all, dir);
-}
-
 /// The implicit part and its mesh, from the same camera: the silhouettes agree on ≥ 99.5 % of
 /// pixels, and where both pictures see a surface away from an edge, the depths agree within
 /// one voxel on ≥ 99.9 % of those pixels (the rest: slivers thinner than a voxel where the
@@ -185,7 +167,7 @@ fn a_part_renders_as_its_mesh_does() {
             &d.join("boss.stl"),
             &meshkit::cuboid([9.0, -3.0, -6.0], [17.0, 3.0, 6.0]),
         );
-        make(d, &args);
+        make_part(d, &args);
         // Cut open, the implicit's caps are where the mesh (not capped) shows its inside: the
         // silhouettes still agree, the depths only away from the cut.
         let (silhouette, _, _) = compare(d, "top", &["--section", cut], distance, voxel);
@@ -236,9 +218,9 @@ fn sphere_tracing_never_tunnels() {
     use latvox::strut::{StrutLattice, UnitCell};
     use latvox::tpms::{Lattice, Structure, Surface};
     let b = |lo: [f64; 3], hi: [f64; 3]| latvox::field::Aabb { min: lo, max: hi };
-    let strut = |name: &str, radius: f64, blend: f64| -> Box<dyn Solid + Send> {
+    let strut = |name: &str, radius: f64, blend: f64| -> Periodic {
         let bounds = b([0.3, -1.0, 0.0], [12.3, 11.0, 12.0]);
-        Box::new(StrutLattice {
+        Periodic::Struts(StrutLattice {
             cell: Arc::new(UnitCell::built_in(name).unwrap()),
             size: [4.0; 3],
             radius,
@@ -247,9 +229,9 @@ fn sphere_tracing_never_tunnels() {
             phase: bounds.min,
         })
     };
-    let sheet = |surface: Surface, level: f64| -> Box<dyn Solid + Send> {
+    let sheet = |surface: Surface, level: f64| -> Periodic {
         let bounds = b([0.0; 3], [15.0, 15.0, 10.0]);
-        Box::new(Lattice {
+        Periodic::Tpms(Lattice {
             surface,
             structure: Structure::Sheet,
             level,
@@ -269,9 +251,9 @@ fn sphere_tracing_never_tunnels() {
     ];
     let mut rng = Rng(0x5eed_2718);
     let (mut hits, mut grazes) = (0, 0);
-    for solid in models {
+    for lattice in models {
         let model = Model {
-            solid,
+            lattice,
             level: 0.0,
             voxel,
             cell: 4.0,
@@ -341,7 +323,7 @@ fn sphere_tracing_never_tunnels() {
 fn sections_and_turntables() {
     let dir = tempdir();
     let d = dir.path();
-    make(
+    make_part(
         d,
         &[
             "tpms",
@@ -477,16 +459,6 @@ fn sections_and_turntables() {
     }
     assert_eq!(frames.len(), 3);
     assert_ne!(frames[0], frames[1], "the views turn");
-}
-
-fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
-    let mut reader = decoder.read_info().unwrap();
-    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
-    let info = reader.next_frame(&mut buf).unwrap();
-    assert_eq!(info.color_type, png::ColorType::Rgb);
-    buf.truncate(info.buffer_size());
-    (info.width, info.height, buf)
 }
 
 /// Unknown views, empty pictures, outputs that are not PNG, part files whose mesh is gone, and

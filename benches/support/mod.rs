@@ -9,7 +9,12 @@ use std::f64::consts::PI;
 
 /// The process's peak resident memory, MB (`VmHWM`).
 pub fn peak_rss_mb() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
+    peak_rss_mb_of("self")
+}
+
+/// The peak resident memory (MB, `VmHWM`) of the running process `pid` (`"self"` for this one).
+pub fn peak_rss_mb_of(pid: &str) -> f64 {
+    std::fs::read_to_string(format!("/proc/{pid}/status"))
         .ok()
         .and_then(|s| {
             s.lines()

@@ -14,6 +14,7 @@ pub mod strut;
 pub mod topo;
 pub mod topopt;
 pub mod tpms;
+pub mod view;
 
 use latvox::Result;
 use std::path::Path;

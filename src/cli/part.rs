@@ -110,12 +110,49 @@ pub fn save(
         };
         table.insert(key.into(), value);
     }
+    write(path, &table)
+}
+
+/// Writes a part file's table (`command` and the settings), atomically.
+pub(crate) fn write(path: &Path, table: &toml::Table) -> Result<()> {
+    let command = table
+        .get("command")
+        .and_then(toml::Value::as_str)
+        .unwrap_or_default();
     let text = format!(
         "# A latvox part: `latvox {command} --part {}` makes it again; options given on the command\n# line override these.\n{}",
         path.file_name().map_or(String::new(), |f| f.to_string_lossy().into_owned()),
-        toml::to_string(&table).map_err(|e| Error::invalid(e.to_string()))?
+        toml::to_string(table).map_err(|e| Error::invalid(e.to_string()))?
     );
     latvox::io::atomic::write_atomic(path, |w| w.write_all(text.as_bytes()))
+}
+
+/// `table` with the files it names by relative paths (relative to the part file at `path`)
+/// named by absolute ones, so that it can be written anywhere.
+pub(crate) fn absolute(mut table: toml::Table, path: &Path) -> toml::Table {
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let dir = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+    let fix = |v: &mut toml::Value| {
+        if let toml::Value::String(s) = v {
+            if Path::new(s.as_str()).is_relative() {
+                *s = dir.join(s.as_str()).display().to_string();
+            }
+        }
+    };
+    for (key, value) in table.iter_mut() {
+        let key = key.replace('_', "-");
+        let cell_file = key == "cell"
+            && value
+                .as_str()
+                .is_some_and(|c| c.to_ascii_lowercase().ends_with(".json"));
+        if PATHS.contains(&key.as_str()) || cell_file {
+            match value {
+                toml::Value::Array(items) => items.iter_mut().for_each(fix),
+                v => fix(v),
+            }
+        }
+    }
+    table
 }
 
 /// A command-line value as TOML: a number, a list of numbers (`4,4,2`), or a string.
@@ -178,7 +215,17 @@ pub fn expand(command: &str, argv: Vec<String>) -> Result<Vec<String>> {
             .ok_or_else(|| Error::invalid("--part needs a part file (FILE.toml)"))?,
     };
     let path = Path::new(&path);
-    let table = read(path)?;
+    expand_table(command, argv, &read(path)?, path)
+}
+
+/// `argv` with the options of a part file's `table` (the file at `path`, which files it names
+/// are relative to) put in front, those the command line gives itself left out.
+fn expand_table(
+    command: &str,
+    argv: Vec<String>,
+    table: &toml::Table,
+    path: &Path,
+) -> Result<Vec<String>> {
     match table.get("command").and_then(toml::Value::as_str) {
         Some(c) if c == command => {}
         Some(c) => {
@@ -204,7 +251,7 @@ pub fn expand(command: &str, argv: Vec<String>) -> Result<Vec<String>> {
         })
     };
     let mut front = Vec::new();
-    for (key, value) in &table {
+    for (key, value) in table {
         if key == "command" {
             continue;
         }
@@ -273,13 +320,17 @@ pub(crate) enum Part {
 
 /// A part file's part.
 pub(crate) fn part_of(path: &Path) -> Result<Part> {
-    let table = super::part::read(path)?;
+    part_of_table(&read(path)?, path)
+}
+
+/// The part of a part file's `table` (the file at `path`, which files it names are relative
+/// to).
+pub(crate) fn part_of_table(table: &toml::Table, path: &Path) -> Result<Part> {
     let command = table
         .get("command")
         .and_then(toml::Value::as_str)
         .unwrap_or_default()
         .to_string();
-    let argv = vec!["--part".to_string(), path.display().to_string()];
     // A setting the part file gives wrongly: said of the part file.
     let named = |e: Error| match e {
         Error::Invalid(m) if !m.contains(&path.display().to_string()) => {
@@ -287,23 +338,23 @@ pub(crate) fn part_of(path: &Path) -> Result<Part> {
         }
         e => e,
     };
-    part_from(&command, argv, path).map_err(named)
+    part_from(&command, table, path).map_err(named)
 }
 
-fn part_from(command: &str, argv: Vec<String>, path: &Path) -> Result<Part> {
+fn part_from(command: &str, table: &toml::Table, path: &Path) -> Result<Part> {
     match command {
         "tpms" => Ok(Part::Block(
-            parse::<super::tpms::TpmsArgs>("tpms", argv)?
+            parse::<super::tpms::TpmsArgs>("tpms", table, path)?
                 .job()?
                 .model()?,
         )),
         "strut" => Ok(Part::Block(
-            parse::<super::strut::StrutArgs>("strut", argv)?
+            parse::<super::strut::StrutArgs>("strut", table, path)?
                 .job()?
                 .model()?,
         )),
         "fill" => Ok(Part::Filled(Box::new(
-            parse::<super::fill::FillArgs>("fill", argv)?
+            parse::<super::fill::FillArgs>("fill", table, path)?
                 .job()?
                 .traced()?,
         ))),
@@ -314,8 +365,12 @@ fn part_from(command: &str, argv: Vec<String>, path: &Path) -> Result<Part> {
     }
 }
 
-fn parse<A: Args + FromArgMatches>(name: &'static str, argv: Vec<String>) -> Result<A> {
-    let argv = expand(name, argv)?;
+fn parse<A: Args + FromArgMatches>(
+    name: &'static str,
+    table: &toml::Table,
+    path: &Path,
+) -> Result<A> {
+    let argv = expand_table(name, Vec::new(), table, path)?;
     let mut cmd = A::augment_args(clap::Command::new(name))
         .no_binary_name(true)
         .disable_help_flag(true);

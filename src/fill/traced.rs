@@ -12,13 +12,13 @@ use super::shape::{skin_or_lattice, Drain};
 use crate::error::Result;
 use crate::field::{intersection_clearance, union_clearance, Aabb, Field, Vec3};
 use crate::grid::GridSpec;
-use crate::mesh::pipeline::Solid;
 use crate::mesh::{norm, sub};
 use crate::render::bvh::Bvh;
 use crate::render::camera::{dot, Ray};
 use crate::render::trace::{
     field_normal, field_openness, mesh_hit, sphere_trace, Hit, Scene, Section, Tolerance,
 };
+use crate::render::Periodic;
 use crate::strut::{RadiusModel, StrutLattice};
 use crate::tpms::{calibrate, Lattice};
 
@@ -29,7 +29,7 @@ pub struct Traced {
     drains: Vec<Drain>,
     skin: f64,
     blend: f64,
-    lattice: Box<dyn Solid + Send>,
+    lattice: Periodic,
     /// The box of the part and the kept solids.
     pub bounds: Aabb,
     /// The voxel meshing would use, mm.
@@ -65,7 +65,7 @@ impl FillJob {
             bounds.min = [0, 1, 2].map(|a| bounds.min[a].min(b.min[a]));
             bounds.max = [0, 1, 2].map(|a| bounds.max[a].max(b.max[a]));
         }
-        let (lattice, level): (Box<dyn Solid + Send>, f64) = match &self.lattice {
+        let (lattice, level) = match &self.lattice {
             Infilling::Tpms { surface, structure } => {
                 let level = calibrate::analytic_level(*surface, *structure, self.density);
                 let solid = Lattice {
@@ -76,7 +76,7 @@ impl FillJob {
                     bounds,
                     phase: bounds.min,
                 };
-                (Box::new(solid), level)
+                (Periodic::Tpms(solid), level)
             }
             Infilling::Strut { cell } => {
                 let radius = RadiusModel::new(cell, self.cell).radius(self.density);
@@ -88,7 +88,7 @@ impl FillJob {
                     bounds,
                     phase: bounds.min,
                 };
-                (Box::new(solid), radius)
+                (Periodic::Struts(solid), radius)
             }
         };
         Ok(Traced {
@@ -108,8 +108,33 @@ impl FillJob {
 
 impl Traced {
     /// The distance up to which the lattice's field is exact (see [`crate::render::Model`]).
-    fn reach(&self) -> f64 {
+    pub fn reach(&self) -> f64 {
         0.15 * self.cell
+    }
+
+    /// The part's surface.
+    pub fn part(&self) -> &Bvh {
+        &self.part
+    }
+
+    /// The solids kept whole.
+    pub fn keep(&self) -> &[Bvh] {
+        &self.keep
+    }
+
+    /// The drain holes.
+    pub fn drains(&self) -> &[Drain] {
+        &self.drains
+    }
+
+    /// The skin's thickness and the blend radius between skin and lattice, mm.
+    pub fn skin_and_blend(&self) -> (f64, f64) {
+        (self.skin, self.blend)
+    }
+
+    /// The lattice that fills the part.
+    pub fn lattice(&self) -> &Periodic {
+        &self.lattice
     }
 
     /// The lattice's field, unclipped, exact up to the reach.
@@ -119,7 +144,7 @@ impl Traced {
             self.voxel,
             (self.reach() / self.voxel).max(1.0),
         );
-        self.lattice.field(&spec)
+        self.lattice.solid().field(&spec)
     }
 
     /// The scene to render, its lattice read from `field` (from [`Traced::lattice_field`]).

@@ -69,11 +69,16 @@ impl Bvh {
             let o = 3 * i as usize;
             [0, 1, 2].map(|a| mesh.positions[o + a] as f64)
         };
-        let mut triangles: Vec<[Vec3; 3]> = mesh
+        let triangles: Vec<[Vec3; 3]> = mesh
             .indices
             .chunks_exact(3)
             .map(|t| [p(t[0]), p(t[1]), p(t[2])])
             .collect();
+        Bvh::over(triangles)
+    }
+
+    /// The hierarchy over `triangles` (given by their corners).
+    pub fn over(mut triangles: Vec<[Vec3; 3]>) -> Bvh {
         let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF + 1);
         if !triangles.is_empty() {
             nodes.push(Node {
@@ -85,6 +90,33 @@ impl Bvh {
             build(&mut triangles, &mut nodes, 0, 0, n);
         }
         Bvh { triangles, nodes }
+    }
+
+    /// The triangles, in the order the leaves list them.
+    pub fn triangles(&self) -> &[[Vec3; 3]] {
+        &self.triangles
+    }
+
+    /// The hierarchy as flat arrays (for a shader): per node its box's lower corner, the index
+    /// of its first child (inner node; the second follows it) or first triangle (leaf), its
+    /// box's upper corner and its triangle count (0 for an inner node); the root first.
+    pub fn nodes(&self) -> Vec<[f64; 8]> {
+        self.nodes
+            .iter()
+            .map(|n| {
+                let (lo, hi) = (n.bounds.min, n.bounds.max);
+                [
+                    lo[0],
+                    lo[1],
+                    lo[2],
+                    n.first as f64,
+                    hi[0],
+                    hi[1],
+                    hi[2],
+                    n.count as f64,
+                ]
+            })
+            .collect()
     }
 
     /// The box of every triangle, or `None` for an empty mesh.

@@ -9,6 +9,7 @@
 pub mod bvh;
 pub mod camera;
 pub mod trace;
+pub mod view;
 
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Field, Vec3};
@@ -23,8 +24,8 @@ use trace::{Scene, Tolerance};
 /// for the part's own cells and voxel) or its strut radius: what rendering and slicing trace
 /// instead of a mesh. Its field is unclipped; the box clips it.
 pub struct Model {
-    /// The solid (its field unclipped; [`Solid::bounds`] is the clipping box).
-    pub solid: Box<dyn Solid + Send>,
+    /// The lattice (its field unclipped; [`Solid::bounds`] is the clipping box).
+    pub lattice: Periodic,
     /// The TPMS level, or the strut radius (mm), the solid is built at.
     pub level: f64,
     /// The voxel meshing it would use, mm: the scale of its finest features.
@@ -44,16 +45,41 @@ impl Model {
     /// The solid's field, unclipped.
     pub fn field(&self) -> Box<dyn Field + '_> {
         let spec = GridSpec::covering(
-            &self.solid.bounds(),
+            &self.solid().bounds(),
             self.voxel,
             (self.reach() / self.voxel).max(1.0),
         );
-        self.solid.field(&spec)
+        self.solid().field(&spec)
+    }
+
+    /// The solid.
+    pub fn solid(&self) -> &(dyn Solid + Send) {
+        self.lattice.solid()
     }
 
     /// The clipping box.
     pub fn bounds(&self) -> Aabb {
-        self.solid.bounds()
+        self.solid().bounds()
+    }
+}
+
+/// A periodic lattice clipped by its box: what a part file describes and the browser editor's
+/// shader draws.
+#[derive(Debug, Clone)]
+pub enum Periodic {
+    /// A TPMS lattice.
+    Tpms(crate::tpms::Lattice),
+    /// A strut lattice.
+    Struts(crate::strut::StrutLattice),
+}
+
+impl Periodic {
+    /// The lattice as a solid.
+    pub fn solid(&self) -> &(dyn Solid + Send) {
+        match self {
+            Periodic::Tpms(l) => l,
+            Periodic::Struts(l) => l,
+        }
     }
 }
 

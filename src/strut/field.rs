@@ -21,7 +21,7 @@ use super::cell::UnitCell;
 use crate::field::{numeric_gradient, periodic, smooth_min, Field, Vec3};
 
 /// Bins per axis of the cell's index.
-const BINS: usize = 4;
+pub const BINS: usize = 4;
 
 /// One strut of the augmented cell, in the cell's centred coordinates (mm).
 #[derive(Debug, Clone, Copy)]
@@ -234,6 +234,21 @@ impl StrutField {
     /// Struts of the augmented cell (the cell's own and the copies that reach into it).
     pub fn strut_count(&self) -> usize {
         self.struts.len()
+    }
+
+    /// The struts of the augmented cell, in the cell's centred coordinates (mm): their ends and
+    /// the ends' radius factors.
+    pub fn struts(&self) -> impl Iterator<Item = ([Vec3; 2], [f64; 2])> + '_ {
+        self.struts
+            .iter()
+            .map(|s| ([s.a, add(s.a, s.ab)], [s.fa, s.fb]))
+    }
+
+    /// Per bin of the cell's index (bin `(i, j, k)` at `(i·BINS + j)·BINS + k`, bins splitting
+    /// the cell into `BINS` equal parts along each axis), the [`StrutField::struts`] that come
+    /// within reach of it.
+    pub fn bins(&self) -> impl Iterator<Item = &[u32]> + '_ {
+        self.bins.iter().map(Vec::as_slice)
     }
 
     /// The most struts one bin lists: what a sample looks at, at most.

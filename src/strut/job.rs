@@ -206,7 +206,7 @@ impl StrutJob {
         let c = self.domain.cell;
         Ok(crate::render::Model {
             level: radius,
-            solid: Box::new(StrutLattice {
+            lattice: crate::render::Periodic::Struts(StrutLattice {
                 cell: self.cell.clone(),
                 size: c,
                 radius,

@@ -113,7 +113,7 @@ impl TpmsJob {
         };
         Ok(crate::render::Model {
             level,
-            solid: Box::new(Lattice {
+            lattice: crate::render::Periodic::Tpms(Lattice {
                 surface: self.surface,
                 structure: self.structure,
                 level,

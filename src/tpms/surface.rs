@@ -162,6 +162,26 @@ impl Surface {
         }
     }
 
+    /// The terms of `F`, each `coef · Π_a f_a(k_a · 2π u_a)` as `(coef, [(k_a, f_a)])` with
+    /// `f` 0 for 1, 1 for cos and 2 for sin: `F` for code that evaluates it elsewhere (the
+    /// browser editor's shader).
+    pub fn factors(self) -> Vec<(f64, [(u8, u8); 3])> {
+        self.terms()
+            .iter()
+            .map(|t| {
+                let code = |(k, trig): (u8, Trig)| {
+                    let f = match trig {
+                        Trig::One => 0,
+                        Trig::Cos => 1,
+                        Trig::Sin => 2,
+                    };
+                    (k, f)
+                };
+                (t.coef, t.f.map(code))
+            })
+            .collect()
+    }
+
     /// `F` at cell coordinates `u` (one period per unit), with its gradient in `u`.
     pub fn eval(self, u: Vec3) -> (f64, Vec3) {
         let tabs = [

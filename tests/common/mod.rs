@@ -1,5 +1,6 @@
 //! Test helpers that do not use latvox's own code: an STL reader, edge counting by hash map,
-//! volume by the divergence theorem, the TPMS formulas written out directly, a seeded generator.
+//! volume by the divergence theorem, the TPMS formulas written out directly, a seeded generator,
+//! a PNG reader.
 #![allow(dead_code)]
 
 pub mod child;
@@ -18,6 +19,25 @@ pub fn run(args: &[&str], dir: &Path) -> Output {
         .current_dir(dir)
         .output()
         .expect("run latvox")
+}
+
+/// Runs latvox with `args` in `dir`, asserting success.
+pub fn ok(args: &[&str], dir: &Path) {
+    let r = run(args, dir);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+}
+
+/// Makes a part with `args` (a meshing command and its settings) in `dir`: `part.stl` and its
+/// part file `part.toml`.
+pub fn make_part(dir: &Path, args: &[&str]) {
+    let mut all = args.to_vec();
+    all.extend(["-q", "-o", "part.stl", "--save-part", "part.toml"]);
+    ok(&all, dir);
 }
 
 /// Triangles as three corner positions each.
@@ -241,4 +261,15 @@ impl Rng {
     pub fn below(&mut self, n: u64) -> u64 {
         self.next() % n
     }
+}
+
+/// An 8-bit RGB PNG: width, height and the pixels row by row from the top.
+pub fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    buf.truncate(info.buffer_size());
+    (info.width, info.height, buf)
 }

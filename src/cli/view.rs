@@ -1,0 +1,104 @@
+//! `latvox view`: the browser editor of a part file — a local server whose page sphere-traces
+//! the part on the GPU and edits it live (see `latvox::render::view`).
+
+use super::part::{absolute, is_part_file, part_of_table, read, Part};
+use clap::Args;
+use latvox::render::view::scene::Scene;
+use latvox::render::view::{serve, Editor, Hooks};
+use latvox::{Error, Result};
+use serde_json::json;
+use std::io::Write;
+use std::path::PathBuf;
+
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  # A gyroid part, then its editor: open the URL printed on the first line in a browser
+  latvox tpms --type gyroid --density 0.3 --cells 4 -o gyroid.stl --save-part gyroid.toml
+  latvox view gyroid.toml
+
+  # A strut part on a fixed port (e.g. forwarded over SSH from a cluster's login node)
+  latvox strut --cell octet --density 0.2 --cells 5 -o octet.stl --save-part octet.toml
+  latvox view octet.toml --port 8080
+
+The page draws the part straight from its settings, never from a mesh: a WebGL2 shader
+sphere-traces the TPMS formula, or the struts of one augmented unit cell, so a part of a
+million cells draws as fast as one of ten. Drag to turn it, scroll to zoom; the controls edit
+the part (type, structure, cell, cell size, density or radius, blend, the box) and cut it with
+a section plane. \"Save part\" writes the part file; \"Mesh\" and \"Slice\" run latvox on the
+saved settings and show their progress. The server listens on 127.0.0.1 only and serves until
+it is stopped (Ctrl-C).";
+
+#[derive(Args)]
+pub struct ViewArgs {
+    /// The part file (from --save-part of tpms, strut or fill).
+    #[arg(value_name = "PART.toml")]
+    pub input: PathBuf,
+    /// The port to listen on (0: a free one).
+    #[arg(long, default_value_t = 0)]
+    pub port: u16,
+}
+
+pub fn run(a: &ViewArgs) -> Result<i32> {
+    if !is_part_file(&a.input) {
+        return Err(Error::invalid(format!(
+            "{}: the editor opens part files (.toml, from --save-part of tpms, strut or fill); a mesh is drawn by `latvox render`",
+            a.input.display()
+        )));
+    }
+    let path = a.input.clone();
+    let settings = absolute(read(&path)?, &path);
+    let command = settings
+        .get("command")
+        .and_then(toml::Value::as_str)
+        .unwrap_or_default()
+        .to_string();
+    let scene_path = path.clone();
+    let hooks = Hooks {
+        scene: Box::new(move |t| {
+            Ok(match part_of_table(t, &scene_path)? {
+                Part::Block(m) => Scene::of(&m),
+                Part::Filled(traced) => Scene::of_filled(&traced),
+            })
+        }),
+        save: Box::new(super::part::write),
+    };
+    // The part must be drawable before anything is served.
+    (hooks.scene)(&settings)?;
+    let types = latvox::tpms::Surface::ALL.map(|s| s.name());
+    let cells = latvox::strut::cell::BUILT_IN;
+    let choices = match command.as_str() {
+        "tpms" => json!({ "type": types, "structure": ["net", "sheet"] }),
+        "strut" => json!({ "cell": cells }),
+        _ => json!({
+            "lattice": types.iter().chain(cells.iter()).collect::<Vec<_>>(),
+            "structure": ["net", "sheet"],
+        }),
+    };
+    let server = tiny_http::Server::http(("127.0.0.1", a.port))
+        .map_err(|e| Error::invalid(format!("cannot listen on 127.0.0.1:{}: {e}", a.port)))?;
+    let port = server
+        .server_addr()
+        .to_ip()
+        .map(|s| s.port())
+        .ok_or_else(|| Error::invalid("the server has no IP address"))?;
+    let exe = std::env::current_exe().map_err(|e| Error::io("latvox", e))?;
+    let mut out = std::io::stdout();
+    let _ = writeln!(out, "http://127.0.0.1:{port}/");
+    let _ = writeln!(
+        out,
+        "latvox view: editing {} ({command}); stop with Ctrl-C",
+        path.display()
+    );
+    let _ = out.flush();
+    serve(
+        server,
+        Editor {
+            path,
+            settings,
+            choices,
+            exe,
+            hooks,
+        },
+    )?;
+    Ok(0)
+}
