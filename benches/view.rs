@@ -1,5 +1,6 @@
 //! The browser editor's frame rate: `latvox view` serving BCC strut blocks of 10×10×10 and
-//! 100×100×100 cells of 5 mm at density 0.1 and a 10×10×10 gyroid block, its page opened in
+//! 100×100×100 cells of 5 mm at density 0.1, a 10×10×10 gyroid block and a 50 mm cube with a
+//! 1 mm skin filled with BCC in 5 mm cells (cut open at z = 25 mm), its page opened in
 //! headless Chromium (tests/reference/view_page.py, Playwright) at 800 × 600, and `--frames`
 //! frames drawn back to back from the iso view, each waited for (a pixel read back); the median
 //! of `--runs` page loads. By default Chromium draws with SwiftShader (software WebGL2 on the
@@ -9,6 +10,8 @@
 //!
 //! Run: `cargo bench --bench view -- --runs 3 --frames 5 [--gpu]`.
 
+#[path = "../tests/meshkit/mod.rs"]
+mod meshkit;
 mod support;
 
 use std::io::{BufRead, BufReader};
@@ -43,7 +46,12 @@ fn main() {
             "gyroid10",
             "command = \"tpms\"\ntype = \"gyroid\"\ndensity = 0.2\ncells = 10\ncell-size = 5\n",
         ),
+        (
+            "cube10",
+            "command = \"fill\"\ninput = \"cube.stl\"\nskin = 1\nlattice = \"bcc\"\ncell-size = 5\ndensity = 0.1\n",
+        ),
     ];
+    meshkit::write_stl(&d.join("cube.stl"), &meshkit::cuboid([0.0; 3], [50.0; 3]));
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/reference/view_page.py");
     println!("latvox view, 800×600, {frames} frames a load, median of {runs} loads");
     for (name, text) in parts {
@@ -71,6 +79,9 @@ fn main() {
             ]);
             if gpu {
                 c.arg("--gpu");
+            }
+            if name == "cube10" {
+                c.args(["--section", "z=25"]);
             }
             let r = c.output().unwrap();
             assert!(

@@ -2,7 +2,7 @@
 would, and writes what it saw for the Rust test to compare with `latvox render`.
 
     python3 view_page.py URL OUT_DIR --width W --height H --azimuth A --elevation E
-        [--section AXIS=MM] [--edit KEY=VALUE] [--save FILE.toml] [--fps N]
+        [--section AXIS=MM] [--edit KEY=VALUE] [--save FILE.toml] [--fps N] [--shot FILE.png]
 
 Writes OUT_DIR/first.mask and, after the edit, OUT_DIR/edited.mask (one '0'/'1' per pixel, top
 row first: where the page's rays met the part), OUT_DIR/first.rgb (the first frame's colours,
@@ -40,6 +40,7 @@ def main():
     ap.add_argument("--edit", default=None)
     ap.add_argument("--save", default=None)
     ap.add_argument("--fps", type=int, default=0)
+    ap.add_argument("--shot", default=None, help="a screenshot of the whole page (PNG)")
     ap.add_argument("--gpu", action="store_true", help="use the machine's GPU, not SwiftShader")
     a = ap.parse_args()
 
@@ -95,6 +96,8 @@ def main():
         with open(os.path.join(a.out, "first.rgb"), "wb") as f:
             f.write(base64.b64decode(page.evaluate("window.latvox.pixels()")))
         page.locator("#view").screenshot(path=os.path.join(a.out, "page.png"))
+        if a.shot:
+            page.screenshot(path=a.shot)
 
         if a.edit:
             key, value = a.edit.split("=", 1)

@@ -44,9 +44,9 @@ uniform float uReach;
 uniform int uSectionOn;
 uniform vec3 uSectionN;
 uniform float uSectionD;
-// Filled parts: the part's surface and the kept solids as BVHs (two texels per node: lower
-// corner and first child or triangle, upper corner and triangle count; three per triangle).
-uniform int uFill;
+// Filled parts (compiled in where the page defines FILL as 1): the part's surface and the kept
+// solids as BVHs (two texels per node: lower corner and first child or triangle, upper corner
+// and triangle count; three per triangle).
 uniform sampler2D uPartNodes;
 uniform sampler2D uPartTris;
 uniform sampler2D uKeepNodes;
@@ -106,7 +106,7 @@ vec4 fetch(sampler2D s, int i) {
 }
 
 vec4 strutTexel(int i) {
-    return fetch(uStruts, i);
+    return texelFetch(uStruts, ivec2(i % 1024, i / 1024), 0);
 }
 
 // Signed distance to a strut of end radii ra, rb: a capsule, or Quilez's exact round cone.
@@ -163,7 +163,9 @@ float boxValue(vec3 p) {
 }
 
 vec2 latticeVC(vec3 p) {
-    return uKind == 0 ? tpms(p) : struts(p);
+    // Branches, not a conditional expression: a shader compiler may evaluate both of those.
+    if (uKind == 0) return tpms(p);
+    return struts(p);
 }
 
 float lattice(vec3 p) {
@@ -179,6 +181,7 @@ float interClearance(float a, float ca, float b, float cb) {
 }
 
 // ------------------------------------------------------------------------- BVHs (filled parts)
+#if FILL
 
 // Where the ray enters the box before `limit`, or -1.
 float boxEntry(vec3 o, vec3 inv, vec3 lo, vec3 hi, float limit) {
@@ -430,6 +433,8 @@ vec2 inside(vec3 x) {
     return insideAt(x, uSkin > 0.0 ? depth(x) : 0.0);
 }
 
+#endif
+
 // ------------------------------------------------------------------------- lattice blocks
 
 vec2 scene(vec3 p) {
@@ -451,7 +456,11 @@ float unionClearance(float a, float ca, float b, float cb) {
 
 // What sphere tracing steps through: the clipped lattice, or inside a filled part its solid.
 vec2 field(vec3 p) {
-    return uFill == 1 ? inside(p) : scene(p);
+#if FILL
+    return inside(p);
+#else
+    return scene(p);
+#endif
 }
 
 float sceneValue(vec3 p) {
@@ -518,6 +527,7 @@ float trace(vec3 o, vec3 dir, float perDistance) {
     return traceSpan(o, dir, span.x, span.y, perDistance);
 }
 
+#if FILL
 bool onCut(vec3 p) {
     return uSectionOn == 1 && abs(dot(uSectionN, p) - uSectionD) <= 1e-5 * (1.0 + length(p));
 }
@@ -587,6 +597,7 @@ float fillHit(vec3 o, vec3 dir, float perDistance, out vec3 n, out bool cap) {
     }
     return best;
 }
+#endif
 
 vec3 normalAt(vec3 p) {
     float h = uStep;
@@ -599,14 +610,18 @@ vec3 normalAt(vec3 p) {
 
 float openness(vec3 p, vec3 n) {
     // None on a filled part's outer surface.
-    if (uFill == 1 && depth(p) < 5.0 * uStep) return 1.0;
+#if FILL
+    if (depth(p) < 5.0 * uStep) return 1.0;
+#endif
     float occ = 0.0;
     float weight = 1.0;
     for (int k = 1; k <= 5; k++) {
         float h = 0.2 * uAoReach * float(k);
         vec3 q = p + h * n;
         float v = sceneValue(q);
-        if (uFill == 1 && uSectionOn == 1) v = max(v, dot(uSectionN, q) - uSectionD);
+#if FILL
+        if (uSectionOn == 1) v = max(v, dot(uSectionN, q) - uSectionD);
+#endif
         occ += weight * max(h - v, 0.0) / h;
         weight *= 0.6;
     }
@@ -621,17 +636,18 @@ void main() {
     vec3 n;
     bool cap = false;
     float t;
-    if (uFill == 1) {
-        t = fillHit(uEye, dir, 0.25 * pixel, n, cap);
-    } else {
-        t = trace(uEye, dir, 0.25 * pixel);
-    }
+#if FILL
+    t = fillHit(uEye, dir, 0.25 * pixel, n, cap);
+#else
+    t = trace(uEye, dir, 0.25 * pixel);
+#endif
     if (t < 0.0) {
         outColor = vec4(0.0);
         return;
     }
     vec3 p = uEye + t * dir;
-    if (uFill == 0) {
+#if !FILL
+    {
         float tol = 0.25 * pixel * t;
         if (uSectionOn == 1) {
             float d = dot(uSectionN, p) - uSectionD;
@@ -639,6 +655,7 @@ void main() {
         }
         n = cap ? uSectionN : normalAt(p);
     }
+#endif
     vec3 keyLight = normalize(-uForward + 0.8 * uUp - 0.6 * uRight);
     vec3 fillLight = normalize(-uForward - 0.2 * uUp + 0.9 * uRight);
     float open = openness(p, n);

@@ -66,7 +66,6 @@ function camera(width, height) {
 
 let program = null;
 const textures = {};
-const uniforms = {};
 
 function compile(type, source) {
   const sh = gl.createShader(type);
@@ -78,31 +77,49 @@ function compile(type, source) {
   return sh;
 }
 
+let shaderSource = null;
+// Compiled programs, by whether they draw filled parts, with their uniforms' locations.
+const variants = {};
+let uniforms = {};
+
 async function setupGl() {
-  const fragment = await (await fetch('/trace.glsl')).text();
-  const vertex = '#version 300 es\nin vec2 corner;\nvoid main() { gl_Position = vec4(corner, 0.0, 1.0); }\n';
-  program = gl.createProgram();
-  gl.attachShader(program, compile(gl.VERTEX_SHADER, vertex));
-  gl.attachShader(program, compile(gl.FRAGMENT_SHADER, fragment));
-  gl.linkProgram(program);
-  if (!gl.getProgramParameter(program, gl.LINK_STATUS)) {
-    throw new Error('shader: ' + gl.getProgramInfoLog(program));
-  }
-  gl.useProgram(program);
+  shaderSource = await (await fetch('/trace.glsl')).text();
   const buffer = gl.createBuffer();
   gl.bindBuffer(gl.ARRAY_BUFFER, buffer);
   gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-1, -1, 1, -1, -1, 1, 1, 1]), gl.STATIC_DRAW);
-  const at = gl.getAttribLocation(program, 'corner');
-  gl.enableVertexAttribArray(at);
-  gl.vertexAttribPointer(at, 2, gl.FLOAT, false, 0, 0);
-  const n = gl.getProgramParameter(program, gl.ACTIVE_UNIFORMS);
-  for (let i = 0; i < n; i++) {
-    const name = gl.getActiveUniform(program, i).name.replace(/\[0\]$/, '');
-    uniforms[name] = gl.getUniformLocation(program, name);
-  }
   ['uStruts', 'uPartNodes', 'uPartTris', 'uKeepNodes', 'uKeepTris'].forEach((name, unit) => {
     textures[name] = { texture: gl.createTexture(), unit };
   });
+}
+
+// Uses the program for lattice blocks or for filled parts (the shader with FILL 0 or 1: a
+// block's shader holds none of the BVH code, which software WebGL runs far faster).
+function useVariant(fill) {
+  const key = fill ? 1 : 0;
+  if (!variants[key]) {
+    const vertex = '#version 300 es\nin vec2 corner;\nvoid main() { gl_Position = vec4(corner, 0.0, 1.0); }\n';
+    const fragment = shaderSource.replace('#version 300 es\n', `#version 300 es\n#define FILL ${key}\n`);
+    const p = gl.createProgram();
+    gl.attachShader(p, compile(gl.VERTEX_SHADER, vertex));
+    gl.attachShader(p, compile(gl.FRAGMENT_SHADER, fragment));
+    gl.linkProgram(p);
+    if (!gl.getProgramParameter(p, gl.LINK_STATUS)) {
+      throw new Error('shader: ' + gl.getProgramInfoLog(p));
+    }
+    const found = {};
+    const n = gl.getProgramParameter(p, gl.ACTIVE_UNIFORMS);
+    for (let i = 0; i < n; i++) {
+      const name = gl.getActiveUniform(p, i).name.replace(/\[0\]$/, '');
+      found[name] = gl.getUniformLocation(p, name);
+    }
+    variants[key] = { program: p, uniforms: found };
+  }
+  program = variants[key].program;
+  uniforms = variants[key].uniforms;
+  gl.useProgram(program);
+  const at = gl.getAttribLocation(program, 'corner');
+  gl.enableVertexAttribArray(at);
+  gl.vertexAttribPointer(at, 2, gl.FLOAT, false, 0, 0);
 }
 
 function set(name, kind, ...values) {
@@ -137,7 +154,7 @@ function corners(t) {
 function loadScene(scene) {
   let [lo, hi] = scene.bounds;
   const f = scene.fill;
-  set('uFill', '1i', f ? 1 : 0);
+  useVariant(Boolean(f));
   if (f) {
     // A small step past a surface a ray was cast to, and the box grown by it.
     const nudge = 2e-5 * (1 + Math.max(...sub(hi, lo)));
@@ -194,16 +211,20 @@ function size() {
   return [Math.max(1, Math.floor(r.width)), Math.max(1, Math.floor(r.height))];
 }
 
-// Draws one frame now.
-function draw() {
+// Draws one frame now; `coarse`: every `coarse`-th pixel along each axis, stretched (while
+// the part is being turned on a slow machine).
+function draw(coarse) {
   if (!program || !state.scene) return;
-  const [w, h] = size();
+  const [fw, fh] = size();
+  const k = coarse || 1;
+  const w = Math.max(1, Math.round(fw / k));
+  const h = Math.max(1, Math.round(fh / k));
   if (canvas.width !== w || canvas.height !== h) {
     canvas.width = w;
     canvas.height = h;
-    canvas.style.width = w + 'px';
-    canvas.style.height = h + 'px';
   }
+  canvas.style.width = fw + 'px';
+  canvas.style.height = fh + 'px';
   gl.viewport(0, 0, w, h);
   const c = camera(w, h);
   set('uSize', '2f', w, h);
@@ -229,11 +250,31 @@ function draw() {
     + `${state.camera.elevation.toFixed(0)}° · ${c.distance.toFixed(1)} mm`;
 }
 
+// While the mouse turns or zooms the part, frames are drawn coarser when a full one is slow
+// (software WebGL), and the full frame follows once it rests.
 let pending = false;
-function requestDraw() {
+let fullMs = 0;
+let moving = 0;
+let settle = null;
+function requestDraw(interactive) {
+  if (interactive) {
+    moving = performance.now();
+    clearTimeout(settle);
+    settle = setTimeout(() => requestDraw(false), 250);
+  }
   if (pending) return;
   pending = true;
-  requestAnimationFrame(() => { pending = false; draw(); });
+  requestAnimationFrame(() => {
+    pending = false;
+    const busy = performance.now() - moving < 250;
+    const coarse = !busy ? 1 : fullMs > 400 ? 4 : fullMs > 60 ? 2 : 1;
+    const t0 = performance.now();
+    draw(coarse);
+    if (coarse === 1) {
+      gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
+      fullMs = performance.now() - t0;
+    }
+  });
 }
 
 // Frames per second over `n` frames, each waited for.
@@ -472,14 +513,14 @@ function wire() {
     state.camera.elevation = Math.max(-89, Math.min(89,
       state.camera.elevation + 0.4 * (e.clientY - drag.y)));
     drag = { x: e.clientX, y: e.clientY };
-    requestDraw();
+    requestDraw(true);
   });
   canvas.addEventListener('pointerup', () => { drag = null; });
   canvas.addEventListener('wheel', (e) => {
     e.preventDefault();
     const d = state.camera.distance || camera(canvas.width, canvas.height).distance;
     state.camera.distance = d * Math.exp(0.001 * e.deltaY);
-    requestDraw();
+    requestDraw(true);
   }, { passive: false });
   window.addEventListener('resize', requestDraw);
   $('save').addEventListener('click', save);
