@@ -201,8 +201,19 @@ fn the_page_draws_the_part_as_render_does() {
     let (w, h) = (240u32, 180u32);
     for (make, section, edit, saved_line) in cases {
         make_part(d.path(), make);
+        if make[0] == "fill" {
+            // As a hand-written part file names its mesh: relative to itself.
+            let part = d.path().join("part.toml");
+            let text = std::fs::read_to_string(&part).unwrap();
+            let abs = d.path().canonicalize().unwrap().join("cube.stl");
+            let text = text.replace(abs.to_str().unwrap(), "cube.stl");
+            assert!(text.contains("input = \"cube.stl\""), "{text}");
+            std::fs::write(&part, text).unwrap();
+        }
         let server = Server::start("part.toml", d.path());
-        let saved = d.path().join("edited.toml");
+        // Saved in another folder: the files the part names must still be found.
+        std::fs::create_dir_all(d.path().join("saved")).unwrap();
+        let saved = d.path().join("saved").join("edited.toml");
         let mut camera = vec!["--azimuth", "30", "--elevation", "25"];
         let (ws, hs) = (w.to_string(), h.to_string());
         let mut page_args = vec![
@@ -257,7 +268,7 @@ fn the_page_draws_the_part_as_render_does() {
         let text = std::fs::read_to_string(&saved).unwrap();
         assert!(text.contains(saved_line), "{text}");
         let edited = page_mask(&d.path().join("edited.mask"));
-        let cpu_saved = render_mask(d.path(), "edited.toml", &camera, w, h);
+        let cpu_saved = render_mask(d.path(), "saved/edited.toml", &camera, w, h);
         let a = agreement(&cpu_saved, &edited);
         assert!(
             a >= 0.98,
@@ -402,6 +413,15 @@ fn the_server_refuses_bad_requests_and_runs_jobs() {
         assert_eq!(job["report"]["layers"], 20, "{job}");
         assert!(d.path().join("layers.cli").exists());
     }
+    // The stages a job's page shows: latvox's own, one line each when asked for lines.
+    let lines = latvox()
+        .args(["tpms", "--cells", "1", "-o", "staged.stl"])
+        .env("LATVOX_PROGRESS", "lines")
+        .current_dir(d.path())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&lines.stderr);
+    assert!(err.lines().any(|l| l.starts_with("progress: ")), "{err}");
     // A job latvox refuses fails with latvox's reason.
     let (status, _) = server.json(
         "POST",

@@ -130,7 +130,10 @@ pub(crate) fn write(path: &Path, table: &toml::Table) -> Result<()> {
 /// `table` with the files it names by relative paths (relative to the part file at `path`)
 /// named by absolute ones, so that it can be written anywhere.
 pub(crate) fn absolute(mut table: toml::Table, path: &Path) -> toml::Table {
-    let dir = path.parent().unwrap_or(Path::new(""));
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
     let dir = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
     let fix = |v: &mut toml::Value| {
         if let toml::Value::String(s) = v {
