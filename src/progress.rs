@@ -17,7 +17,8 @@ pub struct Progress {
 }
 
 impl Progress {
-    /// Spinners on stderr if it is a terminal and `quiet` is false.
+    /// Spinners on stderr if it is a terminal and `quiet` is false; stage lines instead where
+    /// `LATVOX_PROGRESS=lines` (and `quiet` is false).
     pub fn new(quiet: bool) -> Self {
         let lines = std::env::var("LATVOX_PROGRESS").is_ok_and(|v| v == "lines");
         Progress {

@@ -20,11 +20,17 @@ Examples:
   latvox strut --cell octet --density 0.2 --cells 5 -o octet.stl --save-part octet.toml
   latvox view octet.toml --port 8080
 
+  # A filled part: open it, cut it with the section control, turn it, save, mesh
+  latvox fill bracket.stl --skin 1 --lattice gyroid --cell-size 4 --density 0.2 \\
+      -o filled.stl --save-part filled.toml
+  latvox view filled.toml
+
 The page draws the part straight from its settings, never from a mesh: a WebGL2 shader
-sphere-traces the TPMS formula, or the struts of one augmented unit cell, so a part of a
-million cells draws as fast as one of ten. Drag to turn it, scroll to zoom; the controls edit
-the part (type, structure, cell, cell size, density or radius, blend, the box) and cut it with
-a section plane. \"Save part\" writes the part file; \"Mesh\" and \"Slice\" run latvox on the
+sphere-traces the TPMS formula, or the struts of one augmented unit cell — inside a filled
+part's shell, cast at through its BVH — so a part of a million cells draws as fast as one of
+ten. Drag to turn it, scroll to zoom; the controls edit the part (type, structure, cell or
+lattice, cell size, density or radius, skin, blend, drains, the box) and cut it with a section
+plane. \"Save part\" writes the part file; \"Mesh\" and \"Slice\" run latvox on the
 saved settings and show their progress. The server listens on 127.0.0.1 only and serves until
 it is stopped (Ctrl-C).";
 

@@ -1,5 +1,6 @@
 //! The browser editor: a local HTTP server (127.0.0.1 only) that hands a page its part as the
-//! numbers a WebGL2 fragment shader sphere-traces (TPMS terms, the augmented strut cell), and
+//! numbers a WebGL2 fragment shader sphere-traces (TPMS terms, the augmented strut cell, a
+//! filled part's shell and kept solids as BVHs: [`scene::Scene`]), and
 //! carries out what the page asks — a new part from edited settings, saving the part file,
 //! meshing it or writing its slices as a `latvox` child process whose progress the page polls.
 //! The page never meshes; everything it loads is served from here (no CDN, no build step).
