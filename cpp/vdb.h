@@ -18,6 +18,14 @@ struct VdbGrid {
   ~VdbGrid();
 };
 
+// A .vdb file being put together: named grids, written at once.
+struct VdbFile {
+  struct Impl;
+  std::unique_ptr<Impl> impl;
+  VdbFile();
+  ~VdbFile();
+};
+
 struct Extraction;
 enum class SmoothingMode : uint8_t;
 
@@ -30,6 +38,8 @@ std::unique_ptr<VdbGrid> vdb_grid_from_leaves(double voxel_size, rust::Slice<con
                                               rust::Slice<const float> values);
 
 uint64_t vdb_active_voxels(const VdbGrid& grid);
+// The origins of the grid's leaf nodes (xyz triples, index space).
+rust::Vec<int32_t> vdb_leaf_origins(const VdbGrid& grid);
 uint64_t vdb_memory_bytes(const VdbGrid& grid);
 void vdb_write(const VdbGrid& grid, rust::Str path);
 
@@ -54,5 +64,14 @@ void vdb_volume_to_mesh(const VdbGrid& grid, double isovalue, double adaptivity,
                         rust::Vec<float>& positions, rust::Vec<uint32_t>& indices);
 
 void vdb_extract(const VdbGrid& grid, Extraction& out);
+
+// vdb_file.cc: grids of plain values (NaN: inactive), and files of several named grids.
+std::unique_ptr<VdbGrid> vdb_values_from_leaves(double voxel_size, rust::Slice<const double> origin,
+                                                float background, bool fog,
+                                                rust::Slice<const int32_t> leaf_origins,
+                                                rust::Slice<const float> values);
+std::unique_ptr<VdbFile> vdb_file_new();
+void vdb_file_add(VdbFile& file, const VdbGrid& grid, rust::Str name);
+void vdb_file_write(const VdbFile& file, rust::Str path);
 
 }  // namespace latvox

@@ -87,6 +87,17 @@ std::unique_ptr<VdbGrid> vdb_grid_from_leaves(double voxel_size, rust::Slice<con
   return vdb_handle(grid);
 }
 
+rust::Vec<int32_t> vdb_leaf_origins(const VdbGrid& g) {
+  rust::Vec<int32_t> out;
+  for (auto leaf = g.impl->grid->tree().cbeginLeaf(); leaf; ++leaf) {
+    const auto o = leaf->origin();
+    out.push_back(o.x());
+    out.push_back(o.y());
+    out.push_back(o.z());
+  }
+  return out;
+}
+
 uint64_t vdb_active_voxels(const VdbGrid& g) { return g.impl->grid->activeVoxelCount(); }
 uint64_t vdb_memory_bytes(const VdbGrid& g) { return g.impl->grid->memUsage(); }
 

@@ -9,6 +9,8 @@ PKGS=(
   libimath-dev libblosc-dev zlib1g-dev libboost-dev
   # tests: independent checkers
   admesh libopenvdb-tools
+  # fgm tests: OpenVDB's own Python module reads the .vdb grids back
+  python3-openvdb
   # tests (topo): Python for the published optimisers' reference transcriptions, and the
   # libraries the PyPI gmsh wheel (OpenCASCADE, reads IGES back) links against
   python3 python3-pip python3-venv libglu1-mesa libgl1 libopengl0 libxrender1 libxcursor1

@@ -58,6 +58,7 @@ pub mod cad;
 pub mod check;
 pub mod error;
 pub(crate) mod ffi;
+pub mod fgm;
 pub mod field;
 pub mod fill;
 pub mod grid;

@@ -60,6 +60,11 @@ enum Command {
     /// and adaptive B-spline fitting (Liu et al., Engineering 2018).
     #[command(after_help = cli::topo::EXAMPLES)]
     Topo(cli::topo::TopoArgs),
+    /// Functionally graded material from distance fields: a scanned point cloud (or a mesh) to
+    /// a signed distance grid, material fractions graded by the distance to features, and .vdb
+    /// grids, a coloured mesh and voxel-print PNG stacks.
+    #[command(after_help = cli::fgm::EXAMPLES)]
+    Fgm(cli::fgm::FgmArgs),
     /// Render a picture of a part file, sphere-traced from its implicit solid without meshing
     /// it, or of a mesh file, ray cast.
     #[command(after_help = cli::render::EXAMPLES)]
@@ -170,6 +175,7 @@ fn main() {
         Command::Repair(a) => cli::repair::run(a, cli.quiet),
         Command::Topopt(a) => cli::topopt::run(a, cli.quiet),
         Command::Topo(a) => cli::topo::run(a, cli.quiet),
+        Command::Fgm(a) => cli::fgm::run(a, cli.quiet),
         Command::Batch(a) => cli::batch::run(a, cli.quiet),
         Command::Render(a) => cli::render::run(a),
         Command::View(a) => cli::view::run(a),

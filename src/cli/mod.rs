@@ -3,6 +3,7 @@
 
 pub mod batch;
 pub mod check;
+pub mod fgm;
 pub mod fill;
 pub mod lattice;
 pub(crate) mod out;

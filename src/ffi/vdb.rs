@@ -36,6 +36,7 @@ pub(crate) mod ffi {
         include!("latvox/cpp/vdb.h");
 
         type VdbGrid;
+        type VdbFile;
 
         fn vdb_set_threads(threads: usize);
         fn vdb_grid_from_leaves(
@@ -68,8 +69,20 @@ pub(crate) mod ffi {
         ) -> Result<()>;
         fn vdb_extract(grid: &VdbGrid, out: &mut Extraction) -> Result<()>;
         fn vdb_active_voxels(grid: &VdbGrid) -> u64;
+        fn vdb_leaf_origins(grid: &VdbGrid) -> Vec<i32>;
         fn vdb_memory_bytes(grid: &VdbGrid) -> u64;
         fn vdb_write(grid: &VdbGrid, path: &str) -> Result<()>;
+        fn vdb_values_from_leaves(
+            voxel_size: f64,
+            origin: &[f64],
+            background: f32,
+            fog: bool,
+            leaf_origins: &[i32],
+            values: &[f32],
+        ) -> Result<UniquePtr<VdbGrid>>;
+        fn vdb_file_new() -> UniquePtr<VdbFile>;
+        fn vdb_file_add(file: Pin<&mut VdbFile>, grid: &VdbGrid, name: &str);
+        fn vdb_file_write(file: &VdbFile, path: &str) -> Result<()>;
     }
 }
 

@@ -20,7 +20,10 @@ mod probe;
 mod sample;
 mod smooth;
 mod to_mesh;
+mod values;
 mod write;
+
+pub use write::write_vdb_grids;
 
 pub use smooth::Smoothing;
 

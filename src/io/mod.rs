@@ -14,6 +14,7 @@ pub mod obj;
 pub mod off;
 pub mod ply;
 pub mod png;
+pub mod points;
 pub mod sink;
 pub mod stl;
 pub mod threemf;

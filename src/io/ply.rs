@@ -309,6 +309,84 @@ pub fn parse(data: &[u8]) -> Result<Parsed> {
     sink.finish()
 }
 
+/// The scalar properties `wanted` of every vertex of PLY bytes (a point cloud's `x y z` and its
+/// normals `nx ny nz`, say), row after row; `None` for a property the vertex element lacks.
+/// Other elements are read past.
+pub fn vertex_properties(data: &[u8], wanted: &[&str]) -> Result<(Vec<f64>, Vec<bool>)> {
+    let (enc, elements, start) = header(data)?;
+    let mut body = Body {
+        data,
+        pos: start,
+        enc,
+    };
+    let vertex = elements
+        .iter()
+        .find(|e| e.name == "vertex")
+        .ok_or_else(|| Error::parse("no vertex element"))?;
+    let at: Vec<Option<usize>> = wanted
+        .iter()
+        .map(|w| {
+            vertex
+                .props
+                .iter()
+                .position(|p| matches!(p, Prop::Scalar(n, _) if n == w))
+        })
+        .collect();
+    let mut rows = Vec::new();
+    for el in &elements {
+        let is_vertex = el.name == "vertex";
+        let min_size = if enc == Encoding::Ascii { 2 } else { 1 } * el.props.len().max(1);
+        if el.count > (body.left() / min_size) as u64 {
+            return Err(Error::parse(format!(
+                "element {} says {} items but the file is too short",
+                el.name, el.count
+            )));
+        }
+        if is_vertex {
+            rows.reserve(wanted.len() * el.count as usize);
+        }
+        let mut row = vec![0.0; el.props.len()];
+        for _ in 0..el.count {
+            for (k, prop) in el.props.iter().enumerate() {
+                match prop {
+                    Prop::Scalar(_, t) => row[k] = body.value(*t)?,
+                    Prop::List(_, c, t) => {
+                        let n = body.value(*c)?;
+                        if !(n >= 0.0 && n.fract() == 0.0 && n <= body.left() as f64) {
+                            return Err(Error::parse(format!("{}: bad list length {n}", el.name)));
+                        }
+                        for _ in 0..n as u64 {
+                            body.value(*t)?;
+                        }
+                    }
+                }
+            }
+            if is_vertex {
+                rows.extend(at.iter().map(|a| a.map_or(0.0, |k| row[k])));
+            }
+        }
+        if is_vertex {
+            break;
+        }
+    }
+    Ok((rows, at.iter().map(Option::is_some).collect()))
+}
+
+/// Writes a binary little-endian PLY whose vertices carry colours (`red green blue`, one byte
+/// each, one triple per vertex): what MeshLab, CloudCompare and Blender show as vertex colours.
+pub fn write_coloured(mesh: &Mesh, colours: &[[u8; 3]], w: &mut dyn Write) -> std::io::Result<()> {
+    write!(
+        w,
+        "ply\nformat binary_little_endian 1.0\ncomment written by latvox\nelement vertex {}\n\
+         property float x\nproperty float y\nproperty float z\nproperty uchar red\n\
+         property uchar green\nproperty uchar blue\nelement face {}\n\
+         property list uchar uint vertex_indices\nend_header\n",
+        mesh.vertex_count(),
+        mesh.triangle_count()
+    )?;
+    binary_body(mesh, Some(colours), w)
+}
+
 /// Writes PLY: binary little-endian, or ASCII.
 pub fn write(mesh: &Mesh, ascii: bool, w: &mut dyn Write) -> std::io::Result<()> {
     let format = if ascii {
@@ -333,10 +411,18 @@ pub fn write(mesh: &Mesh, ascii: bool, w: &mut dyn Write) -> std::io::Result<()>
         }
         return Ok(());
     }
+    binary_body(mesh, None, w)
+}
+
+/// The vertices (with their colours, when given) and faces of a binary little-endian PLY.
+fn binary_body(mesh: &Mesh, colours: Option<&[[u8; 3]]>, w: &mut dyn Write) -> std::io::Result<()> {
     let mut buf = Vec::with_capacity(1 << 16);
-    for p in mesh.positions.chunks_exact(3) {
+    for (i, p) in mesh.positions.chunks_exact(3).enumerate() {
         for v in p {
             buf.extend_from_slice(&v.to_le_bytes());
+        }
+        if let Some(c) = colours {
+            buf.extend_from_slice(&c[i]);
         }
         if buf.len() > 60_000 {
             w.write_all(&buf)?;

@@ -5,12 +5,27 @@ use std::path::Path;
 
 /// Writes `rgb` (row by row from the top, three bytes a pixel) as a `width × height` PNG.
 pub fn write_rgb(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<()> {
+    write_colour(path, width, height, ::png::ColorType::Rgb, rgb)
+}
+
+/// Writes `rgba` (four bytes a pixel, alpha last: 0 transparent) as a `width × height` PNG.
+pub fn write_rgba(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
+    write_colour(path, width, height, ::png::ColorType::Rgba, rgba)
+}
+
+fn write_colour(
+    path: &Path,
+    width: u32,
+    height: u32,
+    colour: ::png::ColorType,
+    data: &[u8],
+) -> Result<()> {
     crate::io::atomic::write_atomic(path, |w| {
         let mut e = ::png::Encoder::new(w, width, height);
-        e.set_color(::png::ColorType::Rgb);
+        e.set_color(colour);
         e.set_depth(::png::BitDepth::Eight);
         let mut wr = e.write_header().map_err(std::io::Error::other)?;
-        wr.write_image_data(rgb).map_err(std::io::Error::other)?;
+        wr.write_image_data(data).map_err(std::io::Error::other)?;
         wr.finish().map_err(std::io::Error::other)
     })
 }
