@@ -2,7 +2,8 @@
 // 8^3 leaf blocks sampled in Rust, what it holds, and .vdb output.
 //
 // Leaves are constructed in parallel (TBB), attached serially, then signedFloodFill gives the
-// culled interior its negative sign so volumeToMesh sees one closed surface.
+// culled interior its negative sign so volumeToMesh sees one closed surface — or, when the caller
+// knows which culled blocks are inside (an inside test of its own), they become inside tiles.
 #include <openvdb/tools/SignedFloodFill.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -48,7 +49,9 @@ void vdb_set_threads(std::size_t threads) {
 std::unique_ptr<VdbGrid> vdb_grid_from_leaves(double voxel_size, rust::Slice<const double> origin,
                                               float half_width,
                                               rust::Slice<const int32_t> leaf_origins,
-                                              rust::Slice<const float> values) {
+                                              rust::Slice<const float> values,
+                                              bool flood_fill,
+                                              rust::Slice<const int32_t> inside_tiles) {
   using LeafT = openvdb::FloatTree::LeafNodeType;
   vdb_init();
   if (!(voxel_size > 0.0) || !std::isfinite(voxel_size))
@@ -83,7 +86,17 @@ std::unique_ptr<VdbGrid> vdb_grid_from_leaves(double voxel_size, rust::Slice<con
   });
   auto& tree = grid->tree();
   for (auto* leaf : leaves) tree.addLeaf(leaf);
-  openvdb::tools::signedFloodFill(tree);
+  if (flood_fill) {
+    openvdb::tools::signedFloodFill(tree);
+  } else {
+    // The caller knows the inside: the blocks it names are inside, every other unsampled block
+    // outside (the background).
+    for (std::size_t i = 0; i + 2 < inside_tiles.size(); i += 3) {
+      const openvdb::Coord c(inside_tiles[i], inside_tiles[i + 1], inside_tiles[i + 2]);
+      tree.addTile(1, c, -background, false);
+    }
+    tree.prune();
+  }
   return vdb_handle(grid);
 }
 

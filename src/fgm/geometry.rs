@@ -60,6 +60,8 @@ pub struct ScanSdf<'a> {
     signs: Vec<i8>,
     /// Blocks away from the scan where the inside test changes sign (sampled regardless).
     films: HashSet<[i64; 3]>,
+    /// Per block: whether its centre is inside (the sign of a block the band misses).
+    inside: Vec<bool>,
     method: Sign,
 }
 
@@ -79,6 +81,7 @@ impl<'a> ScanSdf<'a> {
             n,
             signs: Vec::new(),
             films: HashSet::new(),
+            inside: Vec::new(),
             method,
         };
         sdf.classify_blocks();
@@ -118,7 +121,9 @@ impl<'a> ScanSdf<'a> {
         // A block is near the scan when the sampler keeps it for its clearance (the test of
         // `Grid::sample`), so that near and far blocks leave no gap between them.
         let reach = 3.5 * h * 3f64.sqrt() + self.spec.half_width * h;
-        let signs: Vec<i8> = (0..total)
+        // Per block: whether it is near the scan, and its inside test's sign (the winding
+        // number's at every block centre; the line scans' away from the scan only).
+        let classified: Vec<(bool, i8)> = (0..total)
             .into_par_iter()
             .map(|i| {
                 let i = i as i64;
@@ -129,32 +134,51 @@ impl<'a> ScanSdf<'a> {
                 ];
                 let c = self.block_centre(b);
                 let (k, u) = self.cloud.nearest_one(&c);
-                if u - self.trust(k) <= reach {
-                    return 0;
-                }
-                match &self.winding {
-                    Some(w) => {
-                        if w.at(c) > 0.5 {
-                            1
-                        } else {
-                            -1
-                        }
-                    }
+                let near = u - self.trust(k) <= reach;
+                let sign = match &self.winding {
+                    Some(w) if w.at(c) > 0.5 => 1,
+                    Some(_) => -1,
                     None => 2, // decided by the scans below
-                }
+                };
+                (near, sign)
             })
             .collect();
-        self.signs = signs;
+        self.signs = classified
+            .iter()
+            .map(|&(near, s)| if near { 0 } else { s })
+            .collect();
         if self.method == Sign::Scan {
             self.scan_lines();
         }
-        // Blocks away from the scan whose sign differs from a neighbour's, and those neighbours.
+        let test: Vec<i8> = match self.method {
+            Sign::Winding => classified.iter().map(|c| c.1).collect(),
+            Sign::Scan => self.signs.clone(),
+        };
+        // Near the scan the line scans leave the sign open: the tangent planes' there.
+        self.inside = (0..total)
+            .into_par_iter()
+            .map(|i| match test[i] {
+                0 => {
+                    let i = i as i64;
+                    let b = [
+                        self.lo[0] + i / (ny * nz),
+                        self.lo[1] + (i / nz) % ny,
+                        self.lo[2] + i % nz,
+                    ];
+                    self.near_value(self.block_centre(b)).0 < 0.0
+                }
+                s => s > 0,
+            })
+            .collect();
+        // Blocks away from the scan whose sign differs from a neighbour's (near the scan too,
+        // when its sign is known), and those neighbours: the inside test's zero set runs there.
         let mut films = HashSet::new();
         for x in 0..nx {
             for y in 0..ny {
                 for z in 0..nz {
                     let b = [self.lo[0] + x, self.lo[1] + y, self.lo[2] + z];
-                    let s = self.signs[self.block_index(b).unwrap()];
+                    let i = self.block_index(b).unwrap();
+                    let s = test[i];
                     if s == 0 {
                         continue;
                     }
@@ -162,8 +186,9 @@ impl<'a> ScanSdf<'a> {
                         let mut o = b;
                         o[a] += 1;
                         if let Some(j) = self.block_index(o) {
-                            let t = self.signs[j];
-                            if t != 0 && t != s {
+                            let t = test[j];
+                            let far = self.signs[i] != 0 || self.signs[j] != 0;
+                            if t != 0 && t != s && far {
                                 films.insert(b);
                                 films.insert(o);
                             }
@@ -216,6 +241,13 @@ impl<'a> ScanSdf<'a> {
         }
     }
 
+    /// Whether the block whose first sample is `first` is inside (for a block the narrow band
+    /// does not reach: [`crate::grid::Grid::sample_signed`]).
+    pub fn inside_block(&self, first: [i64; 3]) -> bool {
+        self.block_index(first.map(|c| c.div_euclid(8)))
+            .is_some_and(|i| self.inside[i])
+    }
+
     /// The moving-least-squares distance at `q` and the nearest point (index, distance).
     fn near_value(&self, q: Vec3) -> (f64, usize, f64) {
         let mut num = 0.0;
@@ -234,19 +266,19 @@ impl<'a> ScanSdf<'a> {
         (num / den, i0, d0.sqrt())
     }
 
-    /// The value away from the scan: `(½ − w)·2u` or the block's sign times `u`.
-    fn far_value(&self, q: Vec3, u: f64) -> f64 {
+    /// The value away from the scan: `(½ − w)·2u`, or the block's sign times `u` (in a block
+    /// near the scan, which the line scans leave undecided, the tangent planes' sign).
+    fn far_value(&self, q: Vec3, u: f64, near: f64) -> f64 {
         match &self.winding {
             Some(w) => (0.5 - w.at(q)) * 2.0 * u,
             None => {
                 let s = self
                     .block_index(self.block_of(q))
                     .map_or(-1, |i| self.signs[i]);
-                // Near the scan (sign 0) the parity is unknown; the band there is near-valued.
-                if s > 0 {
-                    -u
-                } else {
-                    u
+                match s {
+                    0 => near.signum() * u,
+                    s if s > 0 => -u,
+                    _ => u,
                 }
             }
         }
@@ -260,7 +292,7 @@ impl Field for ScanSdf<'_> {
         if u <= trust {
             return near;
         }
-        let far = self.far_value(q, u);
+        let far = self.far_value(q, u, near);
         let t = ((u - trust) / trust).min(1.0);
         let t = t * t * (3.0 - 2.0 * t);
         (1.0 - t) * near + t * far
@@ -316,7 +348,8 @@ mod tests {
             max: b.max.map(|x| x + m),
         };
         let spec = GridSpec::covering(&bounds, voxel, 3.0);
-        Grid::sample(&ScanSdf::new(cloud, spec, sign), spec).unwrap()
+        let f = ScanSdf::new(cloud, spec, sign);
+        Grid::sample_signed(&f, spec, &|b| f.inside_block(b)).unwrap()
     }
 
     #[test]

@@ -118,7 +118,7 @@ impl FgmJob {
                 check_size(&bounds, self.voxel)?;
                 let spec = GridSpec::covering(&bounds, self.voxel, HALF_WIDTH);
                 let field = ScanSdf::new(&cloud, spec, self.sign);
-                let grid = Grid::sample(&field, spec)?;
+                let grid = Grid::sample_signed(&field, spec, &|b| field.inside_block(b))?;
                 let report = GeometryReport {
                     source: "points",
                     points: Some(cloud.points.len()),

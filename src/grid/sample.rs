@@ -26,6 +26,27 @@ impl Grid {
     /// Samples `field` on the narrow band within the leaf blocks that cover `region` (sample
     /// indices of `spec`).
     pub fn sample_box(field: &dyn Field, spec: GridSpec, region: IndexBox) -> Result<Grid> {
+        Self::sample_blocks(field, spec, region, None)
+    }
+
+    /// As [`Grid::sample`], the sign of every block the band does not reach given by `inside`
+    /// (called with a block's first sample) instead of OpenVDB's flood fill from the band: for
+    /// fields whose own inside test is more trustworthy than the band's closure (a scan with
+    /// holes).
+    pub fn sample_signed(
+        field: &dyn Field,
+        spec: GridSpec,
+        inside: &(dyn Fn([i64; 3]) -> bool + Sync),
+    ) -> Result<Grid> {
+        Self::sample_blocks(field, spec, spec.padded_region(), Some(inside))
+    }
+
+    fn sample_blocks(
+        field: &dyn Field,
+        spec: GridSpec,
+        region: IndexBox,
+        inside: Option<&(dyn Fn([i64; 3]) -> bool + Sync)>,
+    ) -> Result<Grid> {
         let h = spec.voxel;
         let band = spec.half_width * h;
         let lo = region.lo.map(|x| x.div_euclid(8));
@@ -69,6 +90,22 @@ impl Grid {
                 true
             })
             .collect();
+        let inside_tiles: Vec<i32> = match inside {
+            None => Vec::new(),
+            Some(inside) => {
+                let mut sampled_set = vec![false; total];
+                for (k, &idx) in candidates.iter().enumerate() {
+                    sampled_set[idx] = keep[k];
+                }
+                (0..total)
+                    .into_par_iter()
+                    .filter(|&idx| !sampled_set[idx])
+                    .map(|idx| block_at(lo, n, idx).map(|c| c * 8))
+                    .filter(|first| inside(*first))
+                    .flat_map_iter(|first| (0..3).map(move |a| (first[a] - frame[a]) as i32))
+                    .collect()
+            }
+        };
         let mut origins = Vec::with_capacity(candidates.len() * 3);
         let mut w = 0;
         for (k, &idx) in candidates.iter().enumerate() {
@@ -85,9 +122,16 @@ impl Grid {
         values.truncate(w * 512);
         let sampled = w as u64;
         let grid_origin = spec.point(frame).map(|x| x - 0.5 * h);
-        let inner =
-            ffi::vdb_grid_from_leaves(h, &grid_origin, spec.half_width as f32, &origins, &values)
-                .backend("building the OpenVDB grid")?;
+        let inner = ffi::vdb_grid_from_leaves(
+            h,
+            &grid_origin,
+            spec.half_width as f32,
+            &origins,
+            &values,
+            inside.is_none(),
+            &inside_tiles,
+        )
+        .backend("building the OpenVDB grid")?;
         Ok(Grid {
             inner: inner.into(),
             spec,

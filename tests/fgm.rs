@@ -1,0 +1,600 @@
+//! `latvox fgm`: scans to signed distance grids and graded materials, checked against analytic
+//! shapes and independent readers — OpenVDB's Python module and `vdb_print` for the grids, the
+//! analytic distance for the PNG stack's layers.
+
+mod common;
+
+use common::{assert_refusal, files_in, json, run, tempdir, Rng};
+use latvox::fgm::material::{Composition, Feature, Features, Law};
+use latvox::fgm::{FgmJob, Geometry, Sign};
+use latvox::io::points::PointCloud;
+use latvox::progress::Progress;
+use std::f64::consts::PI;
+use std::path::Path;
+
+/// A shape the test knows exactly: its signed distance, and a way to sample its surface.
+#[derive(Clone, Copy)]
+enum Shape {
+    /// Radius 10 mm about (5, −3, 2).
+    Sphere,
+    /// Ring radius 10 mm, tube radius 4 mm, about the z axis through (−2, 1, 3).
+    Torus,
+}
+
+const SPHERE_C: [f64; 3] = [5.0, -3.0, 2.0];
+const TORUS_C: [f64; 3] = [-2.0, 1.0, 3.0];
+
+impl Shape {
+    fn distance(self, p: [f64; 3]) -> f64 {
+        match self {
+            Shape::Sphere => norm(sub(p, SPHERE_C)) - 10.0,
+            Shape::Torus => {
+                let q = sub(p, TORUS_C);
+                let ring = (q[0] * q[0] + q[1] * q[1]).sqrt() - 10.0;
+                (ring * ring + q[2] * q[2]).sqrt() - 4.0
+            }
+        }
+    }
+
+    /// The surface point at parameters (u, v) ∈ [0, 1)², its normal, and whether it lies in
+    /// the patch a 10 % hole removes.
+    fn at(self, u: f64, v: f64) -> ([f64; 3], [f64; 3], bool) {
+        match self {
+            Shape::Sphere => {
+                // Area-uniform: z uniform in [−1, 1]; the hole is the cap z > 0.8 (10 % of the area).
+                let z = 1.0 - 2.0 * u;
+                let r = (1.0 - z * z).sqrt();
+                let n = [r * (2.0 * PI * v).cos(), r * (2.0 * PI * v).sin(), z];
+                (add(SPHERE_C, n.map(|x| 10.0 * x)), n, z > 0.8)
+            }
+            Shape::Torus => {
+                let (phi, theta) = (2.0 * PI * u, 2.0 * PI * v);
+                let n = [
+                    theta.cos() * phi.cos(),
+                    theta.cos() * phi.sin(),
+                    theta.sin(),
+                ];
+                let ring = [10.0 * phi.cos(), 10.0 * phi.sin(), 0.0];
+                let p = add(TORUS_C, add(ring, n.map(|x| 4.0 * x)));
+                // The hole: a fifth of the ring, the upper half of the tube (about 10 %).
+                (p, n, u < 0.2 && v < 0.5)
+            }
+        }
+    }
+
+    /// Whether `p` is near the hole's patch, where the scan says nothing (excluded from the
+    /// distance and sign checks; the rest of the part must be right despite the hole).
+    fn near_hole(self, p: [f64; 3]) -> bool {
+        match self {
+            Shape::Sphere => p[2] - SPHERE_C[2] > 7.0,
+            Shape::Torus => {
+                let q = sub(p, TORUS_C);
+                let phi = q[1].atan2(q[0]).rem_euclid(2.0 * PI) / (2.0 * PI);
+                !(0.3..=0.9).contains(&phi)
+            }
+        }
+    }
+
+    /// Samples `n` surface points (area-uniform), moved along the normal by up to `noise` mm,
+    /// less the hole's patch when `hole`.
+    fn scan(self, n: usize, noise: f64, hole: bool, seed: u64) -> Vec<[f64; 3]> {
+        let mut rng = Rng(seed);
+        let mut out = Vec::new();
+        while out.len() < n {
+            let (u, v) = (rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+            if let Shape::Torus = self {
+                // Area element ∝ 10 + 4 cos θ: rejection keeps the sample uniform.
+                if rng.uniform(0.0, 14.0) > 10.0 + 4.0 * (2.0 * PI * v).cos() {
+                    continue;
+                }
+            }
+            let (p, nrm, in_hole) = self.at(u, v);
+            if hole && in_hole {
+                continue;
+            }
+            let e = rng.uniform(-noise, noise);
+            out.push(add(p, nrm.map(|x| e * x)));
+        }
+        out
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+fn write_xyz(path: &Path, points: &[[f64; 3]]) {
+    let text: String = points
+        .iter()
+        .map(|p| format!("{:.5} {:.5} {:.5}\n", p[0], p[1], p[2]))
+        .collect();
+    std::fs::write(path, text).unwrap();
+}
+
+fn skin_job(points: Vec<[f64; 3]>, voxel: f64) -> FgmJob {
+    FgmJob {
+        geometry: Geometry::Points(PointCloud {
+            points,
+            normals: None,
+        }),
+        input_name: "scan".into(),
+        voxel,
+        sign: Sign::Winding,
+        features: Features {
+            list: vec![Feature::Skin],
+            weights: None,
+        },
+        composition: Composition::new(vec!["A".into(), "B".into()], vec![Law::Power { p: 1.0 }])
+            .unwrap(),
+        dmax: None,
+        verify: latvox::check::verify::Verify::Full,
+    }
+}
+
+/// Sphere and torus scans — clean, with 1 % noise, with a 10 % hole — at 0.4 mm voxels: the
+/// signed distance within half a voxel of the analytic one near the surface (within a voxel of
+/// it; noise: within half a voxel of the noise band), the right sign across the band and deep
+/// inside, the mesh closed and free of self-intersections, its volume the shape's (less what a
+/// hole's film cuts off).
+#[test]
+fn scans_give_the_analytic_distance_and_keep_their_inside() {
+    let voxel = 0.4;
+    for shape in [Shape::Sphere, Shape::Torus] {
+        let size: f64 = match shape {
+            Shape::Sphere => 20.0,
+            Shape::Torus => 28.0,
+        };
+        for (noise, hole) in [(0.0, false), (0.01 * size / 2.0, false), (0.0, true)] {
+            let what = format!(
+                "{} noise {noise} hole {hole}",
+                match shape {
+                    Shape::Sphere => "sphere",
+                    Shape::Torus => "torus",
+                }
+            );
+            let fgm = skin_job(shape.scan(30_000, noise, hole, 7), voxel)
+                .run(&Progress::hidden())
+                .unwrap();
+            assert!(
+                fgm.checks.closed && fgm.checks.outward && fgm.checks.manifold,
+                "{what}"
+            );
+            assert!(!fgm.checks.self_intersecting, "{what}");
+            let mut rng = Rng(11);
+            let (mut worst, mut checked, mut deep) = (0.0f64, 0, 0);
+            let b = 16.0;
+            let c = match shape {
+                Shape::Sphere => SPHERE_C,
+                Shape::Torus => TORUS_C,
+            };
+            for _ in 0..60_000 {
+                let p = add(c, [0, 1, 2].map(|_| rng.uniform(-b, b)));
+                if hole && shape.near_hole(p) {
+                    continue;
+                }
+                let exact = shape.distance(p);
+                let v = fgm.sdf.value_at(p);
+                if exact.abs() < voxel {
+                    worst = worst.max((v - exact).abs());
+                    checked += 1;
+                } else if exact.abs() > noise + 0.5 * voxel {
+                    assert_eq!(
+                        v < 0.0,
+                        exact < 0.0,
+                        "{what}: value {v} at {p:?}, exact distance {exact}"
+                    );
+                    deep += (exact < -3.0 * voxel) as usize;
+                }
+            }
+            assert!(checked > 200 && deep > 1000, "{what}: {checked} {deep}");
+            assert!(
+                worst < 0.5 * voxel + noise,
+                "{what}: worst distance error {worst} mm"
+            );
+            let exact_volume = match shape {
+                Shape::Sphere => 4.0 / 3.0 * PI * 1000.0,
+                Shape::Torus => 2.0 * PI * PI * 10.0 * 16.0,
+            };
+            let v = fgm.checks.volume.unwrap();
+            let tolerance = if hole { 0.05 } else { 0.01 };
+            assert!(
+                (v / exact_volume - 1.0).abs() < tolerance,
+                "{what}: volume {v} vs {exact_volume}"
+            );
+        }
+    }
+}
+
+/// The inside told by line scans (the literature's method) on a clean scan agrees with the
+/// analytic sign; given normals are used as given (and flipped when they point inward).
+#[test]
+fn line_scans_and_given_normals() {
+    let dir = tempdir();
+    let points = Shape::Sphere.scan(20_000, 0.0, false, 3);
+    // x y z nx ny nz, normals pointing inward: latvox flips them.
+    let text: String = points
+        .iter()
+        .map(|p| {
+            let n = sub(SPHERE_C, *p).map(|x| x / 10.0);
+            format!("{} {} {} {} {} {}\n", p[0], p[1], p[2], n[0], n[1], n[2])
+        })
+        .collect();
+    std::fs::write(dir.path().join("s.xyz"), text).unwrap();
+    let out = run(
+        &[
+            "fgm", "--points", "s.xyz", "--voxel", "0.5", "--sign", "scan", "-o", "s.stl",
+            "--report", "r.json", "-q",
+        ],
+        dir.path(),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r = json(&dir.path().join("r.json"));
+    assert_eq!(r["geometry"]["normals_estimated"], false);
+    assert_eq!(r["geometry"]["normals_flipped"], true);
+    assert_eq!(r["geometry"]["sign"], "scan");
+    let v = r["volume"].as_f64().unwrap();
+    assert!((v / (4.0 / 3.0 * PI * 1000.0) - 1.0).abs() < 0.01, "{v}");
+}
+
+/// Runs the Python reader on `vdb` with `materials`.
+fn read_vdb(dir: &Path, vdb: &str, materials: &str) -> serde_json::Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference/fgm_vdb.py");
+    let out = std::process::Command::new("/usr/bin/python3")
+        .arg(script)
+        .args([vdb, materials])
+        .current_dir(dir)
+        .output()
+        .expect("run /usr/bin/python3 (python3-openvdb)");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// Three materials graded from the skin, read back with OpenVDB's Python module: the grids
+/// named and sized as asked (and as `vdb_print` lists them), fractions in [0, 1] summing to 1
+/// at every voxel, each the law applied to that voxel's distance (so every iso-surface of the
+/// distance has one composition), the distance the sphere's analytic depth; and a linear law's
+/// profile linear from the surface inward.
+#[test]
+fn composition_sums_to_one_and_follows_the_distance() {
+    let dir = tempdir();
+    write_xyz(
+        &dir.path().join("s.xyz"),
+        &Shape::Sphere.scan(30_000, 0.0, false, 5),
+    );
+    // Hard deep inside (a smooth step from 4 to 8 mm), Mid near the skin (a table: 0.6 up to
+    // 3 mm, nothing from 5 mm), Soft the rest.
+    std::fs::write(
+        dir.path().join("mid.csv"),
+        "d,fraction\n0,0.6\n3,0.6\n5,0\n",
+    )
+    .unwrap();
+    let out = run(
+        &[
+            "fgm",
+            "--points",
+            "s.xyz",
+            "--voxel",
+            "0.5",
+            "--materials",
+            "Hard,Mid,Soft",
+            "--law",
+            "step:4:8",
+            "--law",
+            "table:mid.csv",
+            "--vdb",
+            "g.vdb",
+            "-o",
+            "g.ply",
+            "-q",
+            "--report",
+            "r.json",
+        ],
+        dir.path(),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let listing = std::process::Command::new("vdb_print")
+        .args(["-l", "g.vdb"])
+        .current_dir(dir.path())
+        .output()
+        .expect("vdb_print (libopenvdb-tools)");
+    let listing = String::from_utf8_lossy(&listing.stdout);
+    for name in ["sdf", "distance", "Hard", "Mid", "Soft"] {
+        assert!(
+            listing.contains(&format!("Name: {name}\n")),
+            "{name} not in {listing}"
+        );
+    }
+    assert_eq!(listing.matches("voxel size: 0.5\n").count(), 5, "{listing}");
+    let v = read_vdb(dir.path(), "g.vdb", "Hard,Mid,Soft");
+    let classes: Vec<(String, String)> = v["grids"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| {
+            (
+                g["name"].as_str().unwrap().into(),
+                g["class"].as_str().unwrap().into(),
+            )
+        })
+        .collect();
+    for (name, class) in [
+        ("sdf", "level set"),
+        ("Hard", "fog volume"),
+        ("Soft", "fog volume"),
+    ] {
+        assert!(
+            classes.contains(&(name.into(), class.into())),
+            "{classes:?}"
+        );
+    }
+    let dmax = json(&dir.path().join("r.json"))["dmax"].as_f64().unwrap();
+    assert!((dmax - 10.0).abs() < 0.5, "d_max {dmax}");
+    let voxels = v["voxels"].as_array().unwrap();
+    assert!(voxels.len() > 20_000, "{}", voxels.len());
+    let (mut sum_err, mut law_err, mut depth_err) = (0.0f64, 0.0f64, 0.0f64);
+    for x in voxels {
+        let p: Vec<f64> = x[0]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_f64().unwrap())
+            .collect();
+        let d = x[1].as_f64().unwrap();
+        let f: Vec<f64> = x[2]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_f64().unwrap())
+            .collect();
+        assert!(f.iter().all(|x| (-1e-6..=1.0 + 1e-6).contains(x)), "{f:?}");
+        sum_err = sum_err.max((f.iter().sum::<f64>() - 1.0).abs());
+        // The laws, written out here.
+        let t = ((d - 4.0) / 4.0).clamp(0.0, 1.0);
+        let mid = if d <= 3.0 {
+            0.6
+        } else {
+            (0.6 * (5.0 - d) / 2.0).max(0.0)
+        };
+        let want = [t * t * (3.0 - 2.0 * t), mid];
+        law_err = law_err
+            .max((f[0] - want[0]).abs())
+            .max((f[1] - want[1]).abs());
+        let depth = -Shape::Sphere.distance([p[0], p[1], p[2]]);
+        if depth > 0.0 {
+            depth_err = depth_err.max((d - depth).abs());
+        }
+    }
+    assert!(sum_err < 1e-6, "fractions sum to 1 within {sum_err}");
+    assert!(law_err < 1e-5, "fractions follow the laws within {law_err}");
+    assert!(
+        depth_err < 0.5,
+        "distance to the skin within {depth_err} mm of the depth"
+    );
+
+    // Linear (p = 1) from the surface inward: along the x axis through the centre.
+    write_xyz(
+        &dir.path().join("s.xyz"),
+        &Shape::Sphere.scan(30_000, 0.0, false, 5),
+    );
+    let out = run(
+        &[
+            "fgm", "--points", "s.xyz", "--voxel", "0.5", "--dmax", "10", "--vdb", "l.vdb", "-o",
+            "l.stl", "-q",
+        ],
+        dir.path(),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v = read_vdb(dir.path(), "l.vdb", "A,B");
+    let mut line: Vec<(f64, f64)> = v["voxels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|x| {
+            let p: Vec<f64> = x[0]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|c| c.as_f64().unwrap())
+                .collect();
+            let on_axis = (p[1] - SPHERE_C[1]).abs() < 0.26 && (p[2] - SPHERE_C[2]).abs() < 0.26;
+            (on_axis && p[0] > SPHERE_C[0])
+                .then(|| (10.0 - (p[0] - SPHERE_C[0]), x[2][0].as_f64().unwrap()))
+        })
+        .collect();
+    line.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert!(line.len() >= 15, "{line:?}");
+    for (depth, a) in &line {
+        // A = d / 10 with d the depth: linear, within the distance's half-voxel accuracy.
+        assert!((a - depth / 10.0).abs() < 0.03, "at depth {depth}: A = {a}");
+    }
+}
+
+/// Reads an RGBA PNG (the stack's layers): width, height, pixels.
+fn read_rgba(path: &Path) -> (usize, usize, Vec<u8>) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgba);
+    buf.truncate(info.buffer_size());
+    (info.width as usize, info.height as usize, buf)
+}
+
+/// A PNG stack of a sphere graded from its skin: every layer the same size, each part pixel
+/// one of the palette's colours, outside transparent; per layer, each material's share of the
+/// pixels within 1 % of its mean fraction over them, the fraction computed here from the
+/// analytic depth of each pixel.
+#[test]
+fn png_stack_layers_match_the_field() {
+    let dir = tempdir();
+    write_xyz(
+        &dir.path().join("s.xyz"),
+        &Shape::Sphere.scan(30_000, 0.0, false, 9),
+    );
+    let out = run(
+        &[
+            "fgm",
+            "--points",
+            "s.xyz",
+            "--voxel",
+            "0.4",
+            "--law",
+            "step:0.5:3",
+            "--png-stack",
+            "stack",
+            "--dpi",
+            "150x120",
+            "--layer",
+            "0.8",
+            "--palette",
+            "#ff0000,#0000ff",
+            "-o",
+            "s.stl",
+            "-q",
+        ],
+        dir.path(),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let manifest = json(&dir.path().join("stack/stack.json"));
+    let s = &manifest["stack"];
+    let (layers, width, height) = (
+        s["layers"].as_u64().unwrap() as usize,
+        s["width"].as_u64().unwrap() as usize,
+        s["height"].as_u64().unwrap() as usize,
+    );
+    let px = [25.4 / 150.0, 25.4 / 120.0];
+    let origin: Vec<f64> = s["origin"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_f64().unwrap())
+        .collect();
+    assert_eq!(layers, 25);
+    let mut checked = 0;
+    for l in 0..layers {
+        let (w, h, rgba) = read_rgba(&dir.path().join(format!("stack/layer_{l:05}.png")));
+        assert_eq!((w, h), (width, height));
+        let z = origin[2] + (l as f64 + 0.5) * 0.8;
+        let (mut red, mut part, mut want) = (0usize, 0usize, 0.0f64);
+        for r in 0..h {
+            for c in 0..w {
+                let p = &rgba[4 * (r * w + c)..4 * (r * w + c) + 4];
+                match p {
+                    [_, _, _, 0] => continue,
+                    [255, 0, 0, 255] => red += 1,
+                    [0, 0, 255, 255] => {}
+                    _ => panic!("layer {l}: pixel {p:?} is neither material nor transparent"),
+                }
+                part += 1;
+                let x = origin[0] + (c as f64 + 0.5) * px[0];
+                let y = origin[1] + height as f64 * px[1] - (r as f64 + 0.5) * px[1];
+                let depth = (-Shape::Sphere.distance([x, y, z])).max(0.0);
+                let t = ((depth - 0.5) / 2.5).clamp(0.0, 1.0);
+                want += t * t * (3.0 - 2.0 * t);
+            }
+        }
+        if part >= 500 {
+            let got = red as f64 / part as f64;
+            let expect = want / part as f64;
+            assert!(
+                (got - expect).abs() < 0.01,
+                "layer {l}: share {got} vs field {expect} over {part} pixels"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 20, "{checked} layers checked");
+}
+
+/// Bad input is refused: exit 2, one line, no file written.
+#[test]
+fn bad_input_is_refused() {
+    let dir = tempdir();
+    let d = dir.path();
+    std::fs::write(d.join("empty.xyz"), "").unwrap();
+    std::fs::write(d.join("nan.xyz"), "0 0 0\n1 nan 2\n").unwrap();
+    std::fs::write(d.join("binary.xyz"), [0u8, 159, 146, 150, 255]).unwrap();
+    let few: String = (0..10).map(|i| format!("{i} {} 0\n", i * i)).collect();
+    std::fs::write(d.join("few.xyz"), few).unwrap();
+    write_xyz(&d.join("ok.xyz"), &Shape::Sphere.scan(5_000, 0.0, false, 1));
+    let before = files_in(d);
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--points", "empty.xyz"], "no points"),
+        (vec!["--points", "missing.xyz"], "missing.xyz"),
+        (vec!["--points", "nan.xyz"], "line 2"),
+        (vec!["--points", "binary.xyz"], "binary.xyz"),
+        (vec!["--points", "few.xyz"], "at least 32"),
+        (
+            vec!["--points", "ok.xyz", "--feature", "plane:0,0,1"],
+            "unknown feature",
+        ),
+        (
+            vec!["--points", "ok.xyz", "--law", "linear", "--law", "linear"],
+            "sum to",
+        ),
+        (
+            vec![
+                "--points",
+                "ok.xyz",
+                "--materials",
+                "A,B,C",
+                "--law",
+                "power:1",
+                "--law",
+                "step:0:1",
+            ],
+            "fraction",
+        ),
+        (
+            vec!["--points", "ok.xyz", "--palette", "red,blue"],
+            "palette",
+        ),
+        (vec!["--points", "ok.xyz", "--law", "cubic"], "law 'cubic'"),
+    ];
+    for (args, what) in cases {
+        let mut all = vec![
+            "fgm",
+            "--voxel",
+            "1",
+            "-o",
+            "out.ply",
+            "--vdb",
+            "out.vdb",
+            "--png-stack",
+            "st",
+        ];
+        all.extend(args);
+        let out = run(&all, d);
+        assert_refusal(d, &before, &out, &all, what);
+    }
+}
