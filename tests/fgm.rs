@@ -598,3 +598,102 @@ fn bad_input_is_refused() {
         assert_refusal(d, &before, &out, &all, what);
     }
 }
+
+/// The part's meshes carry the composition: the 3MF read by lib3mf has the named base materials
+/// and a composite group whose mix at each corner is the law at that vertex (graded from a
+/// point: the fraction is the vertex's distance to it over d_max, computed here); the PLY's
+/// vertex colours, read by trimesh, are the palette mixed by the same fractions.
+#[test]
+fn meshes_carry_the_composition() {
+    let dir = tempdir();
+    write_xyz(
+        &dir.path().join("s.xyz"),
+        &Shape::Sphere.scan(20_000, 0.0, false, 4),
+    );
+    let feature = "point:5,-3,12"; // the sphere's top
+    for out in ["m.3mf", "m.ply"] {
+        let r = run(
+            &[
+                "fgm",
+                "--points",
+                "s.xyz",
+                "--voxel",
+                "0.5",
+                "--feature",
+                feature,
+                "--dmax",
+                "20",
+                "--materials",
+                "Stiff,Soft",
+                "--palette",
+                "#ff0000,#0000ff",
+                "-o",
+                out,
+                "-q",
+            ],
+            dir.path(),
+        );
+        assert_eq!(
+            r.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+    }
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference/fgm_mesh.py");
+    let out = std::process::Command::new("python3")
+        .arg(script)
+        .args(["m.3mf", "m.ply"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["bases"], serde_json::json!(["Stiff", "Soft"]));
+    assert!(
+        v["composites"].as_u64().unwrap() > 100,
+        "{}",
+        v["composites"]
+    );
+    let fraction = |p: &[f64]| norm(sub([p[0], p[1], p[2]], [5.0, -3.0, 12.0])) / 20.0;
+    let corners = v["corners"].as_array().unwrap();
+    assert!(corners.len() > 1000);
+    for c in corners {
+        let p: Vec<f64> = c[0]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        let mix: Vec<f64> = c[1]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        let f = fraction(&p);
+        assert!(
+            (mix[0] - f).abs() < 1e-3 && (mix[1] - (1.0 - f)).abs() < 1e-3,
+            "{p:?}: {mix:?} vs {f}"
+        );
+    }
+    let verts = v["ply_vertices"].as_array().unwrap();
+    for (p, c) in verts.iter().zip(v["ply_colours"].as_array().unwrap()) {
+        let p: Vec<f64> = p
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        let f = fraction(&p);
+        let (r, b) = (c[0].as_f64().unwrap(), c[2].as_f64().unwrap());
+        assert!(
+            (r - 255.0 * f).abs() <= 1.0 && (b - 255.0 * (1.0 - f)).abs() <= 1.0,
+            "{p:?}: {c} vs {f}"
+        );
+    }
+}

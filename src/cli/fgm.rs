@@ -47,8 +47,9 @@ last follow their --law, the last takes the rest, so fractions sum to 1 and ever
 d has one composition. Laws: linear, power:P ((d/dmax)^P, dmax by default the largest d in the
 part), step:FROM:TO (a smooth step between two distances, mm), table:FILE.csv (rows d, fraction).
 
-Outputs: -o FILE mesh of the part (.ply with vertex colours mixed from --palette; .stl, .obj,
-.off, .3mf geometry only), checked closed and free of self-intersections; --vdb FILE with grids
+Outputs: -o FILE mesh of the part (.ply with vertex colours mixed from --palette; .3mf with the
+Materials extension's composite materials per vertex over base materials; .stl, .obj, .off
+geometry only), checked closed and free of self-intersections; --vdb FILE with grids
 sdf, distance and one fog grid per material; --png-stack DIR one RGBA picture per layer, each
 pixel one material (error diffusion), outside transparent, with stack.json.";
 
@@ -101,7 +102,8 @@ pub struct FgmArgs {
     /// Colours per material, #RRGGBB comma-separated (meshes' vertex colours, PNG stacks).
     #[arg(long, value_name = "#RGB,#RGB,…")]
     pub palette: Option<String>,
-    /// The part's mesh: .ply (vertex colours), .stl, .obj, .off or .3mf.
+    /// The part's mesh: .ply (vertex colours), .3mf (composite materials per vertex), .stl,
+    /// .obj or .off.
     #[arg(long, short = 'o', value_name = "FILE", default_value = "fgm.ply")]
     pub output: PathBuf,
     /// A .vdb with grids sdf, distance and one per material.
@@ -309,17 +311,25 @@ fn write_mesh(
             path.display()
         ))
     })?;
-    latvox::io::atomic::write_atomic(path, |w| {
-        if format == latvox::io::Format::Ply {
+    latvox::io::atomic::write_atomic(path, |w| match format {
+        latvox::io::Format::Ply => {
             let colours: Vec<[u8; 3]> = fgm
                 .vertex_fractions(&job.features)
                 .iter()
                 .map(|f| latvox::fgm::job::mix(f, palette))
                 .collect();
             latvox::io::ply::write_coloured(&fgm.mesh, &colours, w)
-        } else {
-            latvox::io::write(&fgm.mesh, format, false, w)
         }
+        latvox::io::Format::ThreeMf => {
+            let fractions = fgm.vertex_fractions(&job.features);
+            let c = latvox::io::threemf::Composites {
+                names: &fgm.composition.materials,
+                colours: palette,
+                fractions: &fractions,
+            };
+            latvox::io::threemf::write_composites(&fgm.mesh, &c, w)
+        }
+        _ => latvox::io::write(&fgm.mesh, format, false, w),
     })
 }
 

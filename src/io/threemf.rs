@@ -368,6 +368,92 @@ pub fn write(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
     })
 }
 
+const MATERIAL_NS: &str = "http://schemas.microsoft.com/3dmanufacturing/material/2015/02";
+
+/// Materials mixed per vertex, for the 3MF Materials and Properties extension: base materials
+/// (a name and a colour each) and, per vertex, the fractions of each (summing to 1).
+#[derive(Debug, Clone)]
+pub struct Composites<'a> {
+    /// The base materials' names.
+    pub names: &'a [String],
+    /// Their display colours (RGB).
+    pub colours: &'a [[u8; 3]],
+    /// Per vertex, one fraction per base material.
+    pub fractions: &'a [Vec<f64>],
+}
+
+/// Writes `mesh` as a 3MF package whose vertices carry compositions: a `basematerials` group
+/// of the named materials, a `compositematerials` group over it holding each distinct
+/// composition (fractions rounded to 1/10000), and every triangle's corners pointing at their
+/// vertices' compositions (`p1 p2 p3`), so that a slicer that reads the Materials extension
+/// mixes the materials as graded.
+pub fn write_composites(mesh: &Mesh, c: &Composites, w: &mut dyn Write) -> std::io::Result<()> {
+    if let Some(t) = mesh
+        .indices
+        .chunks_exact(3)
+        .position(|t| t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
+    {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("3MF forbids degenerate triangles and triangle {t} repeats a vertex"),
+        ));
+    }
+    let mut index = std::collections::HashMap::new();
+    let mut composites: Vec<Vec<u32>> = Vec::new();
+    let per_vertex: Vec<u32> = c
+        .fractions
+        .iter()
+        .map(|f| {
+            let q: Vec<u32> = f
+                .iter()
+                .map(|x| (x.clamp(0.0, 1.0) * 1e4).round() as u32)
+                .collect();
+            *index.entry(q.clone()).or_insert_with(|| {
+                composites.push(q);
+                composites.len() as u32 - 1
+            })
+        })
+        .collect();
+    package(w, |x| {
+        write!(
+            x,
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" xml:lang=\"en-US\" xmlns=\"{MODEL_NS}\" xmlns:m=\"{MATERIAL_NS}\">\n<metadata name=\"Application\">latvox</metadata>\n<resources>\n<basematerials id=\"1\">\n"
+        )?;
+        for (name, col) in c.names.iter().zip(c.colours) {
+            writeln!(
+                x,
+                "<base name=\"{name}\" displaycolor=\"#{:02X}{:02X}{:02X}FF\"/>",
+                col[0], col[1], col[2]
+            )?;
+        }
+        let indices: Vec<String> = (0..c.names.len()).map(|i| i.to_string()).collect();
+        writeln!(
+            x,
+            "</basematerials>\n<m:compositematerials id=\"2\" matid=\"1\" matindices=\"{}\">",
+            indices.join(" ")
+        )?;
+        for q in &composites {
+            let v: Vec<String> = q.iter().map(|v| format!("{}", *v as f64 / 1e4)).collect();
+            writeln!(x, "<m:composite values=\"{}\"/>", v.join(" "))?;
+        }
+        x.write_all(b"</m:compositematerials>\n<object id=\"3\" type=\"model\" pid=\"2\" pindex=\"0\">\n<mesh>\n<vertices>\n")?;
+        for p in mesh.positions.chunks_exact(3) {
+            vertex_line(x, p)?;
+        }
+        x.write_all(MODEL_MIDDLE.as_bytes())?;
+        for t in mesh.indices.chunks_exact(3) {
+            let p = [0, 1, 2].map(|k| per_vertex[t[k] as usize]);
+            writeln!(
+                x,
+                "<triangle v1=\"{}\" v2=\"{}\" v3=\"{}\" pid=\"2\" p1=\"{}\" p2=\"{}\" p3=\"{}\"/>",
+                t[0], t[1], t[2], p[0], p[1], p[2]
+            )?;
+        }
+        x.write_all(b"</triangles>\n</mesh>\n</object>\n</resources>\n<build>\n<item objectid=\"3\"/>\n</build>\n</model>\n")?;
+        Ok(())
+    })
+}
+
 const BEAM_NS: &str = "http://schemas.microsoft.com/3dmanufacturing/beamlattice/2017/02";
 
 /// A lattice of beams for the 3MF Beam Lattice extension (v1.2): vertices, beams between them
