@@ -83,7 +83,8 @@ enum Command {
     Batch(cli::batch::BatchArgs),
 }
 
-/// The command line with a part file's options put in (`--part`, for `tpms`, `strut` and `fill`).
+/// The command line with a part file's options put in (`--part`, for `tpms`, `strut`, `fill` and
+/// `fgm`).
 fn expanded_args() -> latvox::Result<Vec<String>> {
     let argv: Vec<String> = std::env::args().collect();
     // The subcommand: the first word that is not a global option or its value.
@@ -96,7 +97,7 @@ fn expanded_args() -> latvox::Result<Vec<String>> {
         }
     }
     match argv.get(i).map(String::as_str) {
-        Some(command @ ("tpms" | "strut" | "fill")) => {
+        Some(command @ ("tpms" | "strut" | "fill" | "fgm")) => {
             let tail = cli::part::expand(command, argv[i + 1..].to_vec())?;
             Ok([&argv[..=i], &tail[..]].concat())
         }

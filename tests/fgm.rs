@@ -697,3 +697,84 @@ fn meshes_carry_the_composition() {
         );
     }
 }
+
+/// An fgm run saved as a part file (its scan and law table by absolute paths) makes the same
+/// part from another folder, and as a `latvox batch` job naming the part file.
+#[test]
+fn part_files_and_batch_jobs_make_the_same_part() {
+    let dir = tempdir();
+    let d = dir.path();
+    write_xyz(&d.join("s.xyz"), &Shape::Sphere.scan(8_000, 0.0, false, 2));
+    std::fs::write(d.join("law.csv"), "0,0.2\n5,0.9\n").unwrap();
+    let first = [
+        "fgm",
+        "--points",
+        "s.xyz",
+        "--voxel",
+        "0.8",
+        "--feature",
+        "skin",
+        "--feature",
+        "point:5,-3,2",
+        "--law",
+        "table:law.csv",
+        "-o",
+        "a.stl",
+        "--report",
+        "a.json",
+        "-q",
+        "--save-part",
+        "a.toml",
+    ];
+    let r = run(&first, d);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let part = std::fs::read_to_string(d.join("a.toml")).unwrap();
+    assert!(
+        part.contains("command = \"fgm\"") && part.contains("feature = ["),
+        "{part}"
+    );
+    std::fs::create_dir(d.join("other")).unwrap();
+    let r = run(
+        &[
+            "fgm",
+            "--part",
+            "../a.toml",
+            "-o",
+            "b.stl",
+            "--report",
+            "b.json",
+            "-q",
+        ],
+        &d.join("other"),
+    );
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    std::fs::write(
+        d.join("jobs.toml"),
+        "[[job]]\ncommand = \"fgm\"\npart = \"a.toml\"\noutput = \"c.stl\"\nreport = \"c.json\"\n",
+    )
+    .unwrap();
+    let r = run(&["batch", "jobs.toml", "-q"], d);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let a = json(&d.join("a.json"));
+    for other in ["other/b.json", "c.json"] {
+        let b = json(&d.join(other));
+        for key in ["triangles", "volume", "dmax", "shares"] {
+            assert_eq!(a[key], b[key], "{other}: {key}");
+        }
+    }
+}

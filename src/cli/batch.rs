@@ -11,6 +11,7 @@
 //! [`COMMANDS`].
 
 use super::clap_message;
+use super::fgm::FgmArgs;
 use super::fill::FillArgs;
 use super::out::outln;
 use super::repair::RepairArgs;
@@ -66,9 +67,9 @@ Job file (paths relative to it; keys are the subcommand's long options):
   layer = 0.05
   csv = \"out/bracket-layers.csv\"
 
-Jobs run the subcommands that make a part — tpms, strut, fill, topo and repair — and slice,
-with the options of `latvox tpms`, `latvox strut`, `latvox fill`, `latvox topo`, `latvox
-repair` and `latvox slice` (`input` is the input file; a slice job passes when every loop
+Jobs run the subcommands that make a part — tpms, strut, fill, fgm, topo and repair — and
+slice, with the options of `latvox tpms`, `latvox strut`, `latvox fill`, `latvox fgm`, `latvox
+topo`, `latvox repair` and `latvox slice` (`input` is the input file; a slice job passes when every loop
 closed).
 
 Examples:
@@ -128,6 +129,7 @@ const COMMANDS: &[(&str, ParseJob)] = &[
     ("tpms", parse_job::<TpmsArgs>),
     ("strut", parse_job::<StrutArgs>),
     ("fill", parse_job::<FillArgs>),
+    ("fgm", parse_job::<FgmArgs>),
     ("topo", parse_job::<TopoArgs>),
     ("repair", parse_job::<RepairArgs>),
     ("slice", parse_job::<SliceArgs>),
@@ -162,6 +164,18 @@ impl Task for FillArgs {
     fn run(&self) -> Result<TaskReport> {
         let r = super::fill::execute(self, &Progress::hidden())?;
         TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
+    }
+}
+
+impl Task for FgmArgs {
+    fn outputs(&self) -> Vec<PathBuf> {
+        super::fgm::outputs(self)
+    }
+
+    fn run(&self) -> Result<TaskReport> {
+        let r = super::fgm::execute(self, &Progress::hidden())?;
+        let verdict = r.checks.verdict();
+        TaskReport::new(&r, &verdict, Vec::new())
     }
 }
 
@@ -216,7 +230,9 @@ where
     let argv = command_line(&cmd, job)?;
     // A job may name a part file (`part = "octet.toml"`): its settings, the job's own first.
     let argv = match name {
-        "tpms" | "strut" | "fill" => super::part::expand(name, argv).map_err(|e| e.to_string())?,
+        "tpms" | "strut" | "fill" | "fgm" => {
+            super::part::expand(name, argv).map_err(|e| e.to_string())?
+        }
         _ => argv,
     };
     let matches = cmd.try_get_matches_from_mut(argv).map_err(clap_message)?;

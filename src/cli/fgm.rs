@@ -127,6 +127,9 @@ pub struct FgmArgs {
     /// Print the report as JSON instead of the summary.
     #[arg(long)]
     pub json: bool,
+    /// Part files.
+    #[command(flatten)]
+    pub part_file: super::lattice::PartArgs,
 }
 
 /// The report of an `fgm` run.
@@ -141,7 +144,8 @@ pub struct FgmReport {
     triangles: usize,
     vertices: usize,
     volume: Option<f64>,
-    checks: latvox::check::cgal::Verification,
+    /// The part mesh's verification (the job's verdict).
+    pub checks: latvox::check::cgal::Verification,
     stack: Option<StackReport>,
     outputs: Vec<String>,
     timings: serde_json::Map<String, serde_json::Value>,
@@ -333,11 +337,34 @@ fn write_mesh(
     })
 }
 
+/// The files a run writes.
+pub fn outputs(a: &FgmArgs) -> Vec<PathBuf> {
+    let mut v = vec![a.output.clone()];
+    v.extend(a.vdb.clone());
+    v.extend(a.png_stack.clone());
+    v
+}
+
 pub fn run(a: &FgmArgs, quiet: bool) -> Result<i32> {
     let progress = Progress::new(quiet || a.json);
     if let Some(r) = &a.report {
         latvox::io::atomic::check_writable(r)?;
     }
+    let report = execute(a, &progress)?;
+    if let Some(r) = &a.report {
+        write_json(r, &report)?;
+    }
+    if a.json {
+        super::out::json(&report);
+    } else {
+        print_summary(&report);
+    }
+    Ok(report.checks.verdict().exit_code())
+}
+
+/// Makes the part and writes its files; returns the report, for `run` to print and `latvox
+/// batch` to record.
+pub fn execute(a: &FgmArgs, progress: &Progress) -> Result<FgmReport> {
     latvox::io::atomic::check_writable(&a.output)?;
     if let Some(v) = &a.vdb {
         latvox::io::atomic::check_writable(v)?;
@@ -345,7 +372,7 @@ pub fn run(a: &FgmArgs, quiet: bool) -> Result<i32> {
     let dpi = parse_dpi(&a.dpi)?;
     let job = a.job()?;
     let palette = a.palette(job.composition.materials.len())?;
-    let fgm = job.run(&progress)?;
+    let fgm = job.run(progress)?;
     let mut outputs = Vec::new();
     let mut timings = serde_json::Map::new();
     for (k, v) in &fgm.timings {
@@ -368,7 +395,7 @@ pub fn run(a: &FgmArgs, quiet: bool) -> Result<i32> {
                 layer: a.layer,
                 palette: palette.clone(),
             };
-            let r = latvox::fgm::stack::write(&fgm, dir, &spec, &progress)?;
+            let r = latvox::fgm::stack::write(&fgm, dir, &spec, progress)?;
             timings.insert("png stack".into(), t.elapsed().as_secs_f64().into());
             outputs.push(dir.display().to_string());
             Some(r)
@@ -390,15 +417,7 @@ pub fn run(a: &FgmArgs, quiet: bool) -> Result<i32> {
         outputs,
         timings,
     };
-    if let Some(r) = &a.report {
-        write_json(r, &report)?;
-    }
-    if a.json {
-        super::out::json(&report);
-    } else {
-        print_summary(&report);
-    }
-    Ok(fgm.checks.verdict().exit_code())
+    Ok(report)
 }
 
 fn print_summary(r: &FgmReport) {

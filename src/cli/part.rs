@@ -1,4 +1,4 @@
-//! Part files: the settings that define a lattice part (`tpms`, `strut` or `fill`), saved as TOML with
+//! Part files: the settings that define a part (`tpms`, `strut`, `fill` or `fgm`), saved as TOML with
 //! `--save-part FILE.toml` and given back with `--part FILE.toml`, so that a part can be made
 //! again, varied, or handed to another tool.
 //!
@@ -36,11 +36,46 @@ const PART_KEYS: &[(&str, &[&str])] = &[
             "keep",
         ],
     ),
+    (
+        "fgm",
+        &[
+            "points",
+            "mesh",
+            "voxel",
+            "sign",
+            "feature",
+            "weights",
+            "materials",
+            "law",
+            "dmax",
+            "palette",
+            "dpi",
+            "layer",
+        ],
+    ),
 ];
 
-/// Options naming files that define the part (the mesh filled, the solids kept): saved as
-/// absolute paths, so that the part file makes the same part from any folder.
-const PATHS: &[&str] = &["input", "keep"];
+/// The commands whose parts are lattices in a box (they share [`COMMON`]).
+const LATTICES: &[&str] = &["tpms", "strut", "fill"];
+
+/// Options naming files that define the part (the mesh filled, the solids kept, the scan):
+/// saved as absolute paths, so that the part file makes the same part from any folder.
+const PATHS: &[&str] = &["input", "keep", "points", "mesh"];
+
+/// Options that may be given several times: saved as lists.
+const REPEATED: &[&str] = &["keep", "feature", "law"];
+
+/// Options whose values may name a file after a kind (`curve:FILE`, `surface:FILE`,
+/// `table:FILE`): the file is saved by its absolute path, and read relative to the part file.
+const EMBEDDED: &[&str] = &["feature", "law"];
+
+/// The file a value of an [`EMBEDDED`] option names, split from its kind.
+fn embedded_file(v: &str) -> Option<(&str, &str)> {
+    let (kind, file) = v.split_once(':')?;
+    ["curve", "surface", "table"]
+        .contains(&kind)
+        .then_some((kind, file))
+}
 
 /// The options of the box and the meshing that define any lattice part.
 const COMMON: &[&str] = &[
@@ -66,7 +101,12 @@ fn keys(command: &str) -> Vec<&'static str> {
         .iter()
         .find(|(c, _)| *c == command)
         .map_or(&[][..], |(_, k)| k);
-    own.iter().chain(COMMON).copied().collect()
+    let common = if LATTICES.contains(&command) {
+        COMMON
+    } else {
+        &[]
+    };
+    own.iter().chain(common).copied().collect()
 }
 
 /// Writes the part file of `command` (its clap command `cmd`) run with `matches`, atomically.
@@ -86,16 +126,28 @@ pub fn save(
             .find_map(|a| matches.try_get_raw(a.get_id().as_str()).ok().flatten());
         let Some(raw) = raw else { continue };
         let mut raw: Vec<String> = raw.map(|v| v.to_string_lossy().into_owned()).collect();
+        let full = |v: &str| -> Result<String> {
+            let p = Path::new(v);
+            Ok(p.canonicalize()
+                .map_err(|e| Error::io(p, e))?
+                .display()
+                .to_string())
+        };
         if PATHS.contains(&key) {
             for v in raw.iter_mut() {
-                let p = Path::new(v.as_str());
-                let full = p.canonicalize().map_err(|e| Error::io(p, e))?;
-                *v = full.display().to_string();
+                *v = full(v)?;
+            }
+        }
+        if EMBEDDED.contains(&key) {
+            for v in raw.iter_mut() {
+                if let Some((kind, file)) = embedded_file(v) {
+                    *v = format!("{kind}:{}", full(file)?);
+                }
             }
         }
         let value = match raw.as_slice() {
             [v] if PATHS.contains(&key) => toml::Value::String(v.clone()),
-            _ if key == "keep" => {
+            _ if REPEATED.contains(&key) => {
                 toml::Value::Array(raw.iter().map(|v| toml::Value::String(v.clone())).collect())
             }
             // A switch: kept only when on.
@@ -239,7 +291,7 @@ fn expand_table(
         }
         None => {
             return Err(Error::invalid(format!(
-                "{}: a part file needs `command` (\"tpms\", \"strut\" or \"fill\")",
+                "{}: a part file needs `command` (\"tpms\", \"strut\", \"fill\" or \"fgm\")",
                 path.display()
             )))
         }
@@ -287,6 +339,12 @@ fn expand_table(
             Some(dir) if names_file && Path::new(file).is_relative() => {
                 dir.join(file).display().to_string()
             }
+            Some(dir) if EMBEDDED.contains(&key.as_str()) => match embedded_file(file) {
+                Some((kind, f)) if Path::new(f).is_relative() => {
+                    format!("{kind}:{}", dir.join(f).display())
+                }
+                _ => file.to_string(),
+            },
             _ => file.to_string(),
         };
         if !matches!(value, toml::Value::Array(_)) {
