@@ -39,6 +39,8 @@ pub struct Cloud {
     pub spacing: Vec<f64>,
     /// The surface area each point stands for, mm².
     pub area: Vec<f64>,
+    /// The median of `spacing`, mm.
+    pub median_spacing: f64,
     /// Whether the normals were estimated (the file gave none).
     pub normals_estimated: bool,
     /// Whether the normals (given or estimated) had to be flipped to point outward.
@@ -79,16 +81,23 @@ impl Cloud {
                 distinct
             )));
         }
-        let spacing: Vec<f64> = points
+        // One neighbour query per point serves the spacing, and the normals when they are
+        // estimated: each point's nearest (itself first), by increasing distance.
+        let k = if normals.is_none() {
+            NORMAL_NEIGHBOURS
+        } else {
+            SPACING_NEIGHBOURS + 1
+        };
+        let (neighbours, spacing): (Vec<Vec<u32>>, Vec<f64>) = points
             .par_iter()
             .map(|p| {
-                let n = tree.nearest_n::<SquaredEuclidean>(
-                    p,
-                    NonZero::new(SPACING_NEIGHBOURS + 1).unwrap(),
-                );
-                n.last().map_or(0.0, |x| x.distance.sqrt())
+                let n = tree.nearest_n::<SquaredEuclidean>(p, NonZero::new(k).unwrap());
+                let spacing = n
+                    .get(SPACING_NEIGHBOURS.min(n.len().saturating_sub(1)))
+                    .map_or(0.0, |x| x.distance.sqrt());
+                (n.iter().map(|x| x.item as u32).collect(), spacing)
             })
-            .collect();
+            .unzip();
         let area: Vec<f64> = spacing
             .iter()
             .map(|r| std::f64::consts::PI * r * r / SPACING_NEIGHBOURS as f64)
@@ -97,14 +106,20 @@ impl Cloud {
         let normals = match normals {
             Some(n) => n,
             None => {
-                let mut n = pca_normals(&points, &tree);
-                orient(&points, &tree, &mut n);
+                let mut n = pca_normals(&points, &neighbours);
+                orient(&points, &neighbours, &mut n);
                 n
             }
+        };
+        let median_spacing = {
+            let mut s = spacing.clone();
+            let mid = s.len() / 2;
+            *s.select_nth_unstable_by(mid, f64::total_cmp).1
         };
         let mut cloud = Cloud {
             points,
             normals,
+            median_spacing,
             spacing,
             area,
             normals_estimated,
@@ -159,13 +174,6 @@ impl Cloud {
         b
     }
 
-    /// The median spacing of the points, mm.
-    pub fn median_spacing(&self) -> f64 {
-        let mut s = self.spacing.clone();
-        let mid = s.len() / 2;
-        *s.select_nth_unstable_by(mid, f64::total_cmp).1
-    }
-
     /// The `k` nearest points to `q`: (index, squared distance), nearest first.
     pub fn nearest(&self, q: &Vec3, k: usize) -> impl Iterator<Item = (usize, f64)> {
         self.tree
@@ -182,23 +190,21 @@ impl Cloud {
 }
 
 /// Each point's least-variance direction among its neighbours (unoriented).
-fn pca_normals(points: &[Vec3], tree: &ImmutableKdTree<f64, 3>) -> Vec<Vec3> {
-    points
+fn pca_normals(points: &[Vec3], neighbours: &[Vec<u32>]) -> Vec<Vec3> {
+    neighbours
         .par_iter()
-        .map(|p| {
-            let near =
-                tree.nearest_n::<SquaredEuclidean>(p, NonZero::new(NORMAL_NEIGHBOURS).unwrap());
+        .map(|near| {
             let mut c = [0.0; 3];
-            for n in &near {
-                let q = points[n.item as usize];
+            for &n in near {
+                let q = points[n as usize];
                 for a in 0..3 {
                     c[a] += q[a];
                 }
             }
             c = c.map(|x| x / near.len() as f64);
             let mut m = [[0.0; 3]; 3];
-            for n in &near {
-                let q = points[n.item as usize];
+            for &n in near {
+                let q = points[n as usize];
                 let d = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
                 for i in 0..3 {
                     for j in 0..3 {
@@ -259,21 +265,13 @@ pub fn least_eigenvector(mut a: [[f64; 3]; 3]) -> Vec3 {
 
 /// Orients `normals` consistently: a minimum spanning tree of the k-nearest-neighbour graph
 /// walked from each piece's highest point (Prim's algorithm), flipping as it goes.
-fn orient(points: &[Vec3], tree: &ImmutableKdTree<f64, 3>, normals: &mut [Vec3]) {
+fn orient(points: &[Vec3], nearest: &[Vec<u32>], normals: &mut [Vec3]) {
     let k = SPACING_NEIGHBOURS + 1;
-    let neighbours: Vec<Vec<u32>> = points
-        .par_iter()
-        .map(|p| {
-            tree.nearest_n::<SquaredEuclidean>(p, NonZero::new(k).unwrap())
-                .into_iter()
-                .map(|n| n.item as u32)
-                .collect()
-        })
-        .collect();
+    let neighbours: Vec<&[u32]> = nearest.iter().map(|n| &n[..k.min(n.len())]).collect();
     // The graph made symmetric, so that a piece is walked whole from any of its points.
-    let mut adjacency: Vec<Vec<u32>> = neighbours.clone();
+    let mut adjacency: Vec<Vec<u32>> = neighbours.iter().map(|n| n.to_vec()).collect();
     for (i, ns) in neighbours.iter().enumerate() {
-        for &j in ns {
+        for &j in ns.iter() {
             if j as usize != i && !neighbours[j as usize].contains(&(i as u32)) {
                 adjacency[j as usize].push(i as u32);
             }

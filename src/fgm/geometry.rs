@@ -165,7 +165,9 @@ impl<'a> ScanSdf<'a> {
                         self.lo[1] + (i / nz) % ny,
                         self.lo[2] + i % nz,
                     ];
-                    self.near_value(self.block_centre(b)).0 < 0.0
+                    let c = self.block_centre(b);
+                    let nearest: Vec<(usize, f64)> = self.cloud.nearest(&c, NEIGHBOURS).collect();
+                    self.near_value(c, &nearest).0 < 0.0
                 }
                 s => s > 0,
             })
@@ -248,22 +250,34 @@ impl<'a> ScanSdf<'a> {
             .is_some_and(|i| self.inside[i])
     }
 
-    /// The moving-least-squares distance at `q` and the nearest point (index, distance).
-    fn near_value(&self, q: Vec3) -> (f64, usize, f64) {
+    /// The moving-least-squares distance at `q` and the nearest point (index, distance), from
+    /// `q`'s nearest points (index, squared distance), nearest first.
+    fn near_value(&self, q: Vec3, nearest: &[(usize, f64)]) -> (f64, usize, f64) {
         let mut num = 0.0;
         let mut den = 0.0;
-        let mut first = None;
-        for (i, d2) in self.cloud.nearest(&q, NEIGHBOURS) {
-            let (i0, d0) = *first.get_or_insert((i, d2));
-            let sigma = self.cloud.spacing[i0].max(self.spec.voxel);
+        let (i0, d0) = nearest.first().copied().unwrap_or((0, 0.0));
+        let sigma = self.cloud.spacing[i0].max(self.spec.voxel);
+        for &(i, d2) in nearest {
             let w = (-(d2 - d0) / (sigma * sigma)).exp();
             let p = self.cloud.points[i];
             let n = self.cloud.normals[i];
             num += w * (n[0] * (q[0] - p[0]) + n[1] * (q[1] - p[1]) + n[2] * (q[2] - p[2]));
             den += w;
         }
-        let (i0, d0) = first.unwrap_or((0, 0.0));
         (num / den, i0, d0.sqrt())
+    }
+
+    /// The field at `q` from its nearest points.
+    fn value_with(&self, q: Vec3, nearest: &[(usize, f64)]) -> f64 {
+        let (near, i0, u) = self.near_value(q, nearest);
+        let trust = self.trust(i0);
+        if u <= trust {
+            return near;
+        }
+        let far = self.far_value(q, u, near);
+        let t = ((u - trust) / trust).min(1.0);
+        let t = t * t * (3.0 - 2.0 * t);
+        (1.0 - t) * near + t * far
     }
 
     /// The value away from the scan: `(½ − w)·2u`, or the block's sign times `u` (in a block
@@ -287,15 +301,8 @@ impl<'a> ScanSdf<'a> {
 
 impl Field for ScanSdf<'_> {
     fn value(&self, q: Vec3) -> f64 {
-        let (near, i0, u) = self.near_value(q);
-        let trust = self.trust(i0);
-        if u <= trust {
-            return near;
-        }
-        let far = self.far_value(q, u, near);
-        let t = ((u - trust) / trust).min(1.0);
-        let t = t * t * (3.0 - 2.0 * t);
-        (1.0 - t) * near + t * far
+        let nearest: Vec<(usize, f64)> = self.cloud.nearest(&q, NEIGHBOURS).collect();
+        self.value_with(q, &nearest)
     }
 
     fn clearance(&self, p: Vec3) -> f64 {

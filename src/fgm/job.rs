@@ -110,7 +110,7 @@ impl FgmJob {
             Geometry::Points(pc) => {
                 let cloud = Cloud::new(pc.clone())?;
                 let b = cloud.bounds();
-                let pad = 2.0 * self.voxel + 3.0 * cloud.median_spacing();
+                let pad = 2.0 * self.voxel + 3.0 * cloud.median_spacing;
                 let bounds = Aabb {
                     min: b.min.map(|x| x - pad),
                     max: b.max.map(|x| x + pad),
@@ -122,7 +122,7 @@ impl FgmJob {
                 let report = GeometryReport {
                     source: "points",
                     points: Some(cloud.points.len()),
-                    point_spacing: Some(cloud.median_spacing()),
+                    point_spacing: Some(cloud.median_spacing),
                     normals_estimated: Some(cloud.normals_estimated),
                     normals_flipped: Some(cloud.normals_flipped),
                     sign: Some(self.sign),
