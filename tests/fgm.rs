@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{assert_refusal, files_in, json, run, tempdir, Rng};
+use common::{assert_refusal, files_in, json, ok, run, tempdir, Rng};
 use latvox::fgm::material::{Composition, Feature, Features, Law};
 use latvox::fgm::{FgmJob, Geometry, Sign};
 use latvox::io::points::PointCloud;
@@ -226,18 +226,12 @@ fn line_scans_and_given_normals() {
         })
         .collect();
     std::fs::write(dir.path().join("s.xyz"), text).unwrap();
-    let out = run(
+    ok(
         &[
             "fgm", "--points", "s.xyz", "--voxel", "0.5", "--sign", "scan", "-o", "s.stl",
             "--report", "r.json", "-q",
         ],
         dir.path(),
-    );
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let r = json(&dir.path().join("r.json"));
     assert_eq!(r["geometry"]["normals_estimated"], false);
@@ -283,7 +277,7 @@ fn composition_sums_to_one_and_follows_the_distance() {
         "d,fraction\n0,0.6\n3,0.6\n5,0\n",
     )
     .unwrap();
-    let out = run(
+    ok(
         &[
             "fgm",
             "--points",
@@ -305,12 +299,6 @@ fn composition_sums_to_one_and_follows_the_distance() {
             "r.json",
         ],
         dir.path(),
-    );
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let listing = std::process::Command::new("vdb_print")
         .args(["-l", "g.vdb"])
@@ -353,19 +341,9 @@ fn composition_sums_to_one_and_follows_the_distance() {
     assert!(voxels.len() > 20_000, "{}", voxels.len());
     let (mut sum_err, mut law_err, mut depth_err) = (0.0f64, 0.0f64, 0.0f64);
     for x in voxels {
-        let p: Vec<f64> = x[0]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|c| c.as_f64().unwrap())
-            .collect();
+        let p: Vec<f64> = numbers(&x[0]);
         let d = x[1].as_f64().unwrap();
-        let f: Vec<f64> = x[2]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|c| c.as_f64().unwrap())
-            .collect();
+        let f: Vec<f64> = numbers(&x[2]);
         assert!(f.iter().all(|x| (-1e-6..=1.0 + 1e-6).contains(x)), "{f:?}");
         sum_err = sum_err.max((f.iter().sum::<f64>() - 1.0).abs());
         // The laws, written out here.
@@ -396,18 +374,12 @@ fn composition_sums_to_one_and_follows_the_distance() {
         &dir.path().join("s.xyz"),
         &Shape::Sphere.scan(30_000, 0.0, false, 5),
     );
-    let out = run(
+    ok(
         &[
             "fgm", "--points", "s.xyz", "--voxel", "0.5", "--dmax", "10", "--vdb", "l.vdb", "-o",
             "l.stl", "-q",
         ],
         dir.path(),
-    );
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let v = read_vdb(dir.path(), "l.vdb", "A,B");
     let mut line: Vec<(f64, f64)> = v["voxels"]
@@ -415,12 +387,7 @@ fn composition_sums_to_one_and_follows_the_distance() {
         .unwrap()
         .iter()
         .filter_map(|x| {
-            let p: Vec<f64> = x[0]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|c| c.as_f64().unwrap())
-                .collect();
+            let p: Vec<f64> = numbers(&x[0]);
             let on_axis = (p[1] - SPHERE_C[1]).abs() < 0.26 && (p[2] - SPHERE_C[2]).abs() < 0.26;
             (on_axis && p[0] > SPHERE_C[0])
                 .then(|| (10.0 - (p[0] - SPHERE_C[0]), x[2][0].as_f64().unwrap()))
@@ -432,6 +399,15 @@ fn composition_sums_to_one_and_follows_the_distance() {
         // A = d / 10 with d the depth: linear, within the distance's half-voxel accuracy.
         assert!((a - depth / 10.0).abs() < 0.03, "at depth {depth}: A = {a}");
     }
+}
+
+/// A JSON array of numbers.
+fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
 }
 
 /// Reads an RGBA PNG (the stack's layers): width, height, pixels.
@@ -456,7 +432,7 @@ fn png_stack_layers_match_the_field() {
         &dir.path().join("s.xyz"),
         &Shape::Sphere.scan(30_000, 0.0, false, 9),
     );
-    let out = run(
+    ok(
         &[
             "fgm",
             "--points",
@@ -478,12 +454,6 @@ fn png_stack_layers_match_the_field() {
             "-q",
         ],
         dir.path(),
-    );
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let manifest = json(&dir.path().join("stack/stack.json"));
     let s = &manifest["stack"];
@@ -612,7 +582,7 @@ fn meshes_carry_the_composition() {
     );
     let feature = "point:5,-3,12"; // the sphere's top
     for out in ["m.3mf", "m.ply"] {
-        let r = run(
+        ok(
             &[
                 "fgm",
                 "--points",
@@ -632,12 +602,6 @@ fn meshes_carry_the_composition() {
                 "-q",
             ],
             dir.path(),
-        );
-        assert_eq!(
-            r.status.code(),
-            Some(0),
-            "{}",
-            String::from_utf8_lossy(&r.stderr)
         );
     }
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference/fgm_mesh.py");
@@ -663,18 +627,8 @@ fn meshes_carry_the_composition() {
     let corners = v["corners"].as_array().unwrap();
     assert!(corners.len() > 1000);
     for c in corners {
-        let p: Vec<f64> = c[0]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_f64().unwrap())
-            .collect();
-        let mix: Vec<f64> = c[1]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_f64().unwrap())
-            .collect();
+        let p: Vec<f64> = numbers(&c[0]);
+        let mix: Vec<f64> = numbers(&c[1]);
         let f = fraction(&p);
         assert!(
             (mix[0] - f).abs() < 1e-3 && (mix[1] - (1.0 - f)).abs() < 1e-3,
@@ -683,12 +637,7 @@ fn meshes_carry_the_composition() {
     }
     let verts = v["ply_vertices"].as_array().unwrap();
     for (p, c) in verts.iter().zip(v["ply_colours"].as_array().unwrap()) {
-        let p: Vec<f64> = p
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_f64().unwrap())
-            .collect();
+        let p: Vec<f64> = numbers(&p);
         let f = fraction(&p);
         let (r, b) = (c[0].as_f64().unwrap(), c[2].as_f64().unwrap());
         assert!(
@@ -739,7 +688,7 @@ fn part_files_and_batch_jobs_make_the_same_part() {
         "{part}"
     );
     std::fs::create_dir(d.join("other")).unwrap();
-    let r = run(
+    ok(
         &[
             "fgm",
             "--part",
@@ -752,24 +701,12 @@ fn part_files_and_batch_jobs_make_the_same_part() {
         ],
         &d.join("other"),
     );
-    assert_eq!(
-        r.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&r.stderr)
-    );
     std::fs::write(
         d.join("jobs.toml"),
         "[[job]]\ncommand = \"fgm\"\npart = \"a.toml\"\noutput = \"c.stl\"\nreport = \"c.json\"\n",
     )
     .unwrap();
-    let r = run(&["batch", "jobs.toml", "-q"], d);
-    assert_eq!(
-        r.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&r.stderr)
-    );
+    ok(&["batch", "jobs.toml", "-q"], d);
     let a = json(&d.join("a.json"));
     for other in ["other/b.json", "c.json"] {
         let b = json(&d.join(other));
@@ -777,4 +714,108 @@ fn part_files_and_batch_jobs_make_the_same_part() {
             assert_eq!(a[key], b[key], "{other}: {key}");
         }
     }
+}
+
+/// A part from a mesh (a closed STL sphere written here) graded from a polyline, a surface and
+/// its skin combined by weights: the distance grid is the weighted mean of the three distances
+/// computed here; the preview is a picture of the section with the part's colours in it.
+#[test]
+fn meshes_curves_surfaces_weights_and_the_preview() {
+    let dir = tempdir();
+    let d = dir.path();
+    // A UV sphere of radius 10 about SPHERE_C, 64 × 32 facets, outward.
+    let (nu, nv) = (64, 32);
+    let at = |i: usize, j: usize| {
+        let (u, v) = (2.0 * PI * i as f64 / nu as f64, PI * j as f64 / nv as f64);
+        add(
+            SPHERE_C,
+            [
+                10.0 * v.sin() * u.cos(),
+                10.0 * v.sin() * u.sin(),
+                10.0 * v.cos(),
+            ],
+        )
+    };
+    let mut stl = String::from("solid s\n");
+    for i in 0..nu {
+        for j in 0..nv {
+            let (a, b, c, e) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            for t in [[a, c, b], [a, e, c]] {
+                if norm(sub(t[0], t[1])) < 1e-9
+                    || norm(sub(t[1], t[2])) < 1e-9
+                    || norm(sub(t[0], t[2])) < 1e-9
+                {
+                    continue;
+                }
+                stl += "facet normal 0 0 0\nouter loop\n";
+                for p in t {
+                    stl += &format!("vertex {} {} {}\n", p[0], p[1], p[2]);
+                }
+                stl += "endloop\nendfacet\n";
+            }
+        }
+    }
+    stl += "endsolid s\n";
+    std::fs::write(d.join("ball.stl"), stl).unwrap();
+    std::fs::write(d.join("axis.csv"), "5,-3,-20\n5,-3,20\n").unwrap();
+    // A plane at z = 2 (two triangles, 100 mm square).
+    std::fs::write(
+        d.join("plane.stl"),
+        "solid p\nfacet normal 0 0 1\nouter loop\nvertex -50 -50 2\nvertex 50 -50 2\nvertex 50 50 2\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex -50 -50 2\nvertex 50 50 2\nvertex -50 50 2\nendloop\nendfacet\nendsolid p\n",
+    )
+    .unwrap();
+    ok(
+        &[
+            "fgm",
+            "--mesh",
+            "ball.stl",
+            "--voxel",
+            "0.5",
+            "--feature",
+            "curve:axis.csv",
+            "--feature",
+            "surface:plane.stl",
+            "--feature",
+            "skin",
+            "--weights",
+            "1,2,1",
+            "--vdb",
+            "w.vdb",
+            "-o",
+            "w.stl",
+            "--preview",
+            "w.png",
+            "--report",
+            "w.json",
+            "-q",
+        ],
+        d,
+    );
+    let rep = json(&d.join("w.json"));
+    assert_eq!(rep["geometry"]["source"], "mesh");
+    let v = read_vdb(d, "w.vdb", "A,B");
+    let mut worst = 0.0f64;
+    let mut n = 0;
+    for x in v["voxels"].as_array().unwrap() {
+        let p: Vec<f64> = numbers(&x[0]);
+        let depth = -Shape::Sphere.distance([p[0], p[1], p[2]]);
+        if depth < 1.0 {
+            continue; // the faceted skin's distance differs from the sphere's there
+        }
+        let axis = ((p[0] - 5.0).powi(2) + (p[1] + 3.0).powi(2)).sqrt();
+        let plane = (p[2] - 2.0).abs();
+        let want = (axis + 2.0 * plane + depth) / 4.0;
+        worst = worst.max((x[1].as_f64().unwrap() - want).abs());
+        n += 1;
+    }
+    assert!(n > 10_000, "{n}");
+    // The skin term is the faceted sphere's distance (its chords lie up to 0.05 mm inside).
+    assert!(worst < 0.1, "weighted distance off by {worst} mm");
+    let (w, h, rgb) = common::read_png(&d.join("w.png"));
+    assert!(w >= 460 && h > 560, "{w} × {h}");
+    let coloured = rgb
+        .chunks_exact(3)
+        .filter(|p| p[0] != p[1] || p[1] != p[2])
+        .count();
+    assert!(coloured > 100_000, "{coloured} coloured pixels");
 }

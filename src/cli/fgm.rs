@@ -51,7 +51,8 @@ Outputs: -o FILE mesh of the part (.ply with vertex colours mixed from --palette
 Materials extension's composite materials per vertex over base materials; .stl, .obj, .off
 geometry only), checked closed and free of self-intersections; --vdb FILE with grids
 sdf, distance and one fog grid per material; --png-stack DIR one RGBA picture per layer, each
-pixel one material (error diffusion), outside transparent, with stack.json.";
+pixel one material (error diffusion), outside transparent, with stack.json; --preview FILE.png a
+section (--preview-z, default mid-height) coloured by composition, with a legend.";
 
 /// Default colours, one per material in order.
 const PALETTE: [[u8; 3]; 6] = [
@@ -118,6 +119,12 @@ pub struct FgmArgs {
     /// Layer thickness of the PNG stack, mm.
     #[arg(long, value_name = "MM", default_value_t = 0.027, value_parser = parse_positive, allow_hyphen_values = true)]
     pub layer: f64,
+    /// A picture: a horizontal section coloured by composition, with a legend.
+    #[arg(long, value_name = "FILE.png")]
+    pub preview: Option<PathBuf>,
+    /// The preview's section height, mm (default: the part's mid-height).
+    #[arg(long, value_name = "Z", allow_hyphen_values = true)]
+    pub preview_z: Option<f64>,
     /// How the part's mesh is verified: full, fast, none or cgal.
     #[arg(long, value_enum, default_value = "full", value_name = "HOW")]
     pub verify: Verify,
@@ -342,6 +349,7 @@ pub fn outputs(a: &FgmArgs) -> Vec<PathBuf> {
     let mut v = vec![a.output.clone()];
     v.extend(a.vdb.clone());
     v.extend(a.png_stack.clone());
+    v.extend(a.preview.clone());
     v
 }
 
@@ -366,8 +374,8 @@ pub fn run(a: &FgmArgs, quiet: bool) -> Result<i32> {
 /// batch` to record.
 pub fn execute(a: &FgmArgs, progress: &Progress) -> Result<FgmReport> {
     latvox::io::atomic::check_writable(&a.output)?;
-    if let Some(v) = &a.vdb {
-        latvox::io::atomic::check_writable(v)?;
+    for p in a.vdb.iter().chain(&a.preview) {
+        latvox::io::atomic::check_writable(p)?;
     }
     let dpi = parse_dpi(&a.dpi)?;
     let job = a.job()?;
@@ -379,6 +387,10 @@ pub fn execute(a: &FgmArgs, progress: &Progress) -> Result<FgmReport> {
         timings.insert(k.to_string(), (*v).into());
     }
     let t = std::time::Instant::now();
+    // The preview first: a section height outside the part is refused before any file is made.
+    if let Some(p) = &a.preview {
+        latvox::fgm::preview::write(&fgm, p, &palette, a.preview_z)?;
+    }
     write_mesh(&a.output, &fgm, &job, &palette)?;
     outputs.push(a.output.display().to_string());
     if let Some(v) = &a.vdb {
@@ -386,6 +398,7 @@ pub fn execute(a: &FgmArgs, progress: &Progress) -> Result<FgmReport> {
         fgm.write_vdb(v)?;
         outputs.push(v.display().to_string());
     }
+    outputs.extend(a.preview.iter().map(|p| p.display().to_string()));
     timings.insert("write".into(), t.elapsed().as_secs_f64().into());
     let stack = match &a.png_stack {
         Some(dir) => {

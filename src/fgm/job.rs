@@ -157,9 +157,16 @@ impl FgmJob {
 
         let t = Instant::now();
         let stage = progress.stage("mesh");
-        let mut keyed = KeyedMesh::extract(&sdf)?;
-        keyed.triangulate();
-        let mesh = keyed.into_mesh();
+        let mesh = match &self.geometry {
+            // Sampled here, its values kept off zero: every vertex keyed to its voxel.
+            Geometry::Points(_) => {
+                let mut keyed = KeyedMesh::extract(&sdf)?;
+                keyed.triangulate();
+                keyed.into_mesh()
+            }
+            // OpenVDB's own distance, which may be 0 on a sample: its own mesher.
+            Geometry::Mesh(_) => sdf.to_mesh(0.0)?,
+        };
         if mesh.triangle_count() == 0 {
             return Err(Error::invalid(
                 "the geometry encloses nothing at this voxel size (a finer --voxel, or a closed scan)",

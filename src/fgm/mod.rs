@@ -1,21 +1,23 @@
 //! Functionally graded material (FGM) by distance fields: a part's geometry as a signed
 //! distance field (from a scanned point cloud or a mesh), its material as fractions that are
 //! functions of the distance to material features, so that every iso-surface of that distance
-//! has one composition — the implicit FGM modelling of Kou & Tan ("A systematic approach for
-//! integrated computer-aided design and finite element analysis of functionally-graded-material
-//! objects", Materials & Design 2007) and the distance-field patents after it.
+//! has one composition — heterogeneous material modelling with distance fields (Biswas, Shapiro
+//! and Tsukanov, "Heterogeneous material modeling with distance fields", Computer Aided
+//! Geometric Design 21, 2004).
 //!
 //! - [`cloud`]: points made ready (normals estimated and oriented, spacing, areas);
 //! - [`winding`]: fast generalised winding numbers of the oriented points;
 //! - [`geometry`]: the signed distance [`crate::field::Field`] of a scan, sampled into a grid;
 //! - [`material`]: features, the distance to them, laws and compositions;
 //! - [`job`]: geometry → grid → mesh (checked) → material distance, and the `.vdb` and meshes;
-//! - [`stack`]: voxel-print PNG stacks by error diffusion.
+//! - [`stack`]: voxel-print PNG stacks by error diffusion;
+//! - [`preview`]: a section coloured by composition, with a legend.
 
 pub mod cloud;
 pub mod geometry;
 pub mod job;
 pub mod material;
+pub mod preview;
 pub mod stack;
 pub mod winding;
 

@@ -9,6 +9,7 @@
 //! known extension are recognised by their first bytes.
 
 pub mod atomic;
+pub mod canvas;
 pub mod npy;
 pub mod obj;
 pub mod off;

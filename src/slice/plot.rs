@@ -1,101 +1,16 @@
 //! The layer plot (`--plot FILE.png`): layer thickness (top) and cross-section area (bottom)
 //! against height, as an 8-bit RGB PNG — a look at where adaptive layers thinned and why.
-//! Drawn directly (lines, ticks and a 5 × 7 pixel font), no plotting library.
+//! Drawn directly on latvox's canvas (lines, ticks and a 5 × 7 pixel font), no plotting library.
 
 use super::Layer;
 use crate::error::Result;
+use crate::io::canvas::Canvas;
 use std::path::Path;
 
 const W: usize = 960;
 const H: usize = 640;
 const LEFT: usize = 110;
 const RIGHT: usize = 30;
-
-struct Canvas {
-    rgb: Vec<u8>,
-}
-
-impl Canvas {
-    fn put(&mut self, x: i64, y: i64, c: [u8; 3]) {
-        if x >= 0 && y >= 0 && (x as usize) < W && (y as usize) < H {
-            let i = 3 * (y as usize * W + x as usize);
-            self.rgb[i..i + 3].copy_from_slice(&c);
-        }
-    }
-
-    fn line(&mut self, a: (f64, f64), b: (f64, f64), c: [u8; 3]) {
-        let n = ((b.0 - a.0).abs().max((b.1 - a.1).abs()).ceil() as usize).max(1);
-        for k in 0..=n {
-            let t = k as f64 / n as f64;
-            let (x, y) = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
-            self.put(x.round() as i64, y.round() as i64, c);
-            self.put(x.round() as i64, y.round() as i64 + 1, c);
-        }
-    }
-
-    /// Text in the 5 × 7 font, `scale` pixels a dot, left edge at `x`, top at `y`.
-    fn text(&mut self, x: i64, y: i64, s: &str, scale: i64) {
-        let mut cx = x;
-        for ch in s.chars() {
-            if let Some(rows) = glyph(ch) {
-                for (r, bits) in rows.iter().enumerate() {
-                    for col in 0..5 {
-                        if bits >> (4 - col) & 1 == 1 {
-                            for dy in 0..scale {
-                                for dx in 0..scale {
-                                    self.put(
-                                        cx + col * scale + dx,
-                                        y + r as i64 * scale + dy,
-                                        [40, 40, 40],
-                                    );
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-            cx += 6 * scale;
-        }
-    }
-}
-
-/// The 5 × 7 dots of the characters the plot writes (rows top down, 5 bits each).
-fn glyph(c: char) -> Option<[u8; 7]> {
-    Some(match c {
-        '0' => [14, 17, 19, 21, 25, 17, 14],
-        '1' => [4, 12, 4, 4, 4, 4, 14],
-        '2' => [14, 17, 1, 2, 4, 8, 31],
-        '3' => [31, 2, 4, 2, 1, 17, 14],
-        '4' => [2, 6, 10, 18, 31, 2, 2],
-        '5' => [31, 16, 30, 1, 1, 17, 14],
-        '6' => [6, 8, 16, 30, 17, 17, 14],
-        '7' => [31, 1, 2, 4, 8, 8, 8],
-        '8' => [14, 17, 17, 14, 17, 17, 14],
-        '9' => [14, 17, 17, 15, 1, 2, 12],
-        '.' => [0, 0, 0, 0, 0, 12, 12],
-        '-' => [0, 0, 0, 31, 0, 0, 0],
-        '(' => [2, 4, 8, 8, 8, 4, 2],
-        ')' => [8, 4, 2, 2, 2, 4, 8],
-        '²' => [12, 2, 4, 8, 14, 0, 0],
-        'a' => [0, 0, 14, 1, 15, 17, 15],
-        'c' => [0, 0, 14, 16, 16, 17, 14],
-        'e' => [0, 0, 14, 17, 31, 16, 14],
-        'g' => [0, 15, 17, 17, 15, 1, 14],
-        'h' => [16, 16, 22, 25, 17, 17, 17],
-        'i' => [4, 0, 12, 4, 4, 4, 14],
-        'k' => [16, 16, 18, 20, 24, 20, 18],
-        'l' => [12, 4, 4, 4, 4, 4, 14],
-        'm' => [0, 0, 26, 21, 21, 17, 17],
-        'n' => [0, 0, 22, 25, 17, 17, 17],
-        'r' => [0, 0, 22, 25, 16, 16, 16],
-        's' => [0, 0, 14, 16, 14, 1, 30],
-        't' => [8, 8, 28, 8, 8, 9, 6],
-        'y' => [0, 0, 17, 17, 15, 1, 14],
-        'z' => [0, 0, 31, 2, 4, 8, 31],
-        ' ' => [0; 7],
-        _ => return None,
-    })
-}
 
 /// About five round tick values covering `lo..hi`.
 fn ticks(lo: f64, hi: f64) -> Vec<f64> {
@@ -128,11 +43,9 @@ fn label(v: f64) -> String {
 
 /// Writes the plot of `layers` and their `areas` (mm²) to `path`.
 pub fn write_plot(path: &Path, layers: &[Layer], areas: &[f64]) -> Result<()> {
-    let mut c = Canvas {
-        rgb: vec![255; 3 * W * H],
-    };
+    let mut c = Canvas::new(W, H, [255; 3]);
     if layers.is_empty() {
-        return crate::io::png::write_rgb(path, W as u32, H as u32, &c.rgb);
+        return c.write_png(path);
     }
     let z0 = layers[0].bottom();
     let z1 = layers.last().map_or(z0 + 1.0, |l| l.top()).max(z0 + 1e-9);
@@ -198,5 +111,5 @@ pub fn write_plot(path: &Path, layers: &[Layer], areas: &[f64]) -> Result<()> {
         }
     }
     c.text((W / 2) as i64 - 36, (H - 22) as i64, "z (mm)", 2);
-    crate::io::png::write_rgb(path, W as u32, H as u32, &c.rgb)
+    c.write_png(path)
 }

@@ -1,0 +1,90 @@
+//! A picture of an FGM part to look at before printing it: a horizontal section at height `z`
+//! (the middle of the part by default), every pixel of the part coloured by its composition —
+//! the palette's colours mixed by the fractions there, read from the grids as the PNG stack
+//! reads them — and a legend: each material's colour and name, and a bar of the composition
+//! against the distance to the features, from 0 to d_max.
+
+use super::job::{mix, Fgm};
+use crate::error::{Error, Result};
+use crate::io::canvas::Canvas;
+use std::path::Path;
+
+/// The section's longer side, pixels.
+const SIDE: f64 = 560.0;
+const MARGIN: usize = 20;
+
+/// Writes the preview of `fgm`, its section at `z` (mm; the part's mid-height when `None`).
+pub fn write(fgm: &Fgm, path: &Path, palette: &[[u8; 3]], z: Option<f64>) -> Result<()> {
+    let b = fgm
+        .mesh
+        .bounds()
+        .ok_or_else(|| Error::invalid("the part is empty"))?;
+    let z = z.unwrap_or(0.5 * (b.min[2] + b.max[2]));
+    if !(b.min[2]..=b.max[2]).contains(&z) {
+        return Err(Error::invalid(format!(
+            "--preview-z {z} is outside the part ({:.3} to {:.3} mm)",
+            b.min[2], b.max[2]
+        )));
+    }
+    let size = b.size();
+    let scale = SIDE / size[0].max(size[1]).max(1e-9);
+    let (pw, ph) = (
+        (size[0] * scale).ceil() as usize,
+        (size[1] * scale).ceil() as usize,
+    );
+    let n = fgm.composition.materials.len();
+    let legend = 70 + 22 * n;
+    let width = (pw + 2 * MARGIN).max(460);
+    let mut c = Canvas::new(width, ph + 2 * MARGIN + legend, [255; 3]);
+    let mut pts = vec![0.0; 3 * pw];
+    let (mut s, mut d) = (vec![0f32; pw], vec![0f32; pw]);
+    let mut f = vec![0.0; n];
+    for r in 0..ph {
+        let y = b.max[1] - (r as f64 + 0.5) / scale;
+        for col in 0..pw {
+            pts[3 * col] = b.min[0] + (col as f64 + 0.5) / scale;
+            pts[3 * col + 1] = y;
+            pts[3 * col + 2] = z;
+        }
+        fgm.sdf.probe(&pts, &mut s);
+        fgm.distance_grid.probe(&pts, &mut d);
+        for col in 0..pw {
+            if s[col] <= 0.0 {
+                fgm.fractions_at(d[col] as f64, &mut f);
+                c.put((MARGIN + col) as i64, (MARGIN + r) as i64, mix(&f, palette));
+            }
+        }
+    }
+    // The legend: the section's height, the materials, and the composition against distance.
+    let top = (ph + 2 * MARGIN) as i64;
+    c.text(MARGIN as i64, top, &format!("section z = {}", short(z)), 2);
+    for (k, name) in fgm.composition.materials.iter().enumerate() {
+        let y = top + 24 + 22 * k as i64;
+        c.rect(MARGIN as i64, y, 16, 16, palette[k]);
+        c.text(MARGIN as i64 + 24, y + 1, name, 2);
+    }
+    let bar_x = (MARGIN + 200) as i64;
+    let bar_w = width as i64 - bar_x - MARGIN as i64;
+    let bar_y = top + 24;
+    for i in 0..bar_w {
+        let dist = fgm.dmax * i as f64 / (bar_w - 1).max(1) as f64;
+        fgm.fractions_at(dist, &mut f);
+        c.rect(bar_x + i, bar_y, 1, 24, mix(&f, palette));
+    }
+    c.text(bar_x, bar_y + 30, "0", 2);
+    let right = format!("{} mm", short(fgm.dmax));
+    c.text(
+        bar_x + bar_w - 12 * right.chars().count() as i64,
+        bar_y + 30,
+        &right,
+        2,
+    );
+    c.text(bar_x, bar_y + 52, "distance to features", 2);
+    c.write_png(path)
+}
+
+/// A number with at most three decimals, trailing zeros dropped.
+fn short(x: f64) -> String {
+    let s = format!("{x:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
