@@ -637,7 +637,7 @@ fn meshes_carry_the_composition() {
     }
     let verts = v["ply_vertices"].as_array().unwrap();
     for (p, c) in verts.iter().zip(v["ply_colours"].as_array().unwrap()) {
-        let p: Vec<f64> = numbers(&p);
+        let p: Vec<f64> = numbers(p);
         let f = fraction(&p);
         let (r, b) = (c[0].as_f64().unwrap(), c[2].as_f64().unwrap());
         assert!(
