@@ -567,6 +567,23 @@ fn bad_input_is_refused() {
         let out = run(&all, d);
         assert_refusal(d, &before, &out, &all, what);
     }
+    // Refused once the part is known, still before any file is made.
+    let late: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--png-stack", "no/such/folder"], "does not exist"),
+        (vec!["--png-stack", "st", "--dpi", "100000"], "lower --dpi"),
+        (
+            vec!["--preview", "p.png", "--preview-z", "1000"],
+            "outside the part",
+        ),
+    ];
+    for (args, what) in late {
+        let mut all = vec![
+            "fgm", "--points", "ok.xyz", "--voxel", "1", "-o", "out.ply", "--vdb", "out.vdb",
+        ];
+        all.extend(args);
+        let out = run(&all, d);
+        assert_refusal(d, &before, &out, &all, what);
+    }
 }
 
 /// The part's meshes carry the composition: the 3MF read by lib3mf has the named base materials

@@ -377,6 +377,16 @@ pub fn execute(a: &FgmArgs, progress: &Progress) -> Result<FgmReport> {
     for p in a.vdb.iter().chain(&a.preview) {
         latvox::io::atomic::check_writable(p)?;
     }
+    if let Some(dir) = &a.png_stack {
+        if dir.exists() && !dir.is_dir() {
+            return Err(Error::invalid(format!(
+                "{}: exists and is not a folder",
+                dir.display()
+            )));
+        }
+        // The folder is filled beside where it goes, then renamed: its parent must take files.
+        latvox::io::atomic::check_writable(&dir.with_extension("latvox-probe"))?;
+    }
     let dpi = parse_dpi(&a.dpi)?;
     let job = a.job()?;
     let palette = a.palette(job.composition.materials.len())?;
@@ -386,8 +396,19 @@ pub fn execute(a: &FgmArgs, progress: &Progress) -> Result<FgmReport> {
     for (k, v) in &fgm.timings {
         timings.insert(k.to_string(), (*v).into());
     }
+    // Whatever can be refused is refused before the first file is made.
+    let spec = StackSpec {
+        dpi,
+        layer: a.layer,
+        palette: palette.clone(),
+    };
+    if a.png_stack.is_some() {
+        latvox::fgm::stack::plan(&fgm, &spec)?;
+    }
+    if a.preview.is_some() {
+        latvox::fgm::preview::section_height(&fgm, a.preview_z)?;
+    }
     let t = std::time::Instant::now();
-    // The preview first: a section height outside the part is refused before any file is made.
     if let Some(p) = &a.preview {
         latvox::fgm::preview::write(&fgm, p, &palette, a.preview_z)?;
     }
@@ -403,11 +424,6 @@ pub fn execute(a: &FgmArgs, progress: &Progress) -> Result<FgmReport> {
     let stack = match &a.png_stack {
         Some(dir) => {
             let t = std::time::Instant::now();
-            let spec = StackSpec {
-                dpi,
-                layer: a.layer,
-                palette: palette.clone(),
-            };
             let r = latvox::fgm::stack::write(&fgm, dir, &spec, progress)?;
             timings.insert("png stack".into(), t.elapsed().as_secs_f64().into());
             outputs.push(dir.display().to_string());

@@ -13,8 +13,8 @@ use std::path::Path;
 const SIDE: f64 = 560.0;
 const MARGIN: usize = 20;
 
-/// Writes the preview of `fgm`, its section at `z` (mm; the part's mid-height when `None`).
-pub fn write(fgm: &Fgm, path: &Path, palette: &[[u8; 3]], z: Option<f64>) -> Result<()> {
+/// The section's height: `z`, or the part's mid-height; refused outside the part.
+pub fn section_height(fgm: &Fgm, z: Option<f64>) -> Result<f64> {
     let b = fgm
         .mesh
         .bounds()
@@ -26,6 +26,16 @@ pub fn write(fgm: &Fgm, path: &Path, palette: &[[u8; 3]], z: Option<f64>) -> Res
             b.min[2], b.max[2]
         )));
     }
+    Ok(z)
+}
+
+/// Writes the preview of `fgm`, its section at `z` (mm; the part's mid-height when `None`).
+pub fn write(fgm: &Fgm, path: &Path, palette: &[[u8; 3]], z: Option<f64>) -> Result<()> {
+    let z = section_height(fgm, z)?;
+    let b = fgm
+        .mesh
+        .bounds()
+        .ok_or_else(|| Error::invalid("the part is empty"))?;
     let size = b.size();
     let scale = SIDE / size[0].max(size[1]).max(1e-9);
     let (pw, ph) = (

@@ -60,8 +60,19 @@ pub struct StackReport {
 /// A layer's material pixel counts, fraction sums, part pixels and worst share error.
 type LayerCounts = (Vec<u64>, Vec<f64>, u64, f64);
 
-/// Writes the stack of `fgm` into the folder `dir` (replaced whole when done).
-pub fn write(fgm: &Fgm, dir: &Path, spec: &StackSpec, progress: &Progress) -> Result<StackReport> {
+/// The stack's geometry: the part's box, the pixel size, pictures' size and their count.
+pub struct Plan {
+    corner: [f64; 3],
+    px: [f64; 2],
+    width: usize,
+    height: usize,
+    layers: usize,
+    top: f64,
+}
+
+/// Checks `spec` against `fgm` (a colour per material, a stack of sane size) and lays the
+/// stack out; nothing is written.
+pub fn plan(fgm: &Fgm, spec: &StackSpec) -> Result<Plan> {
     let n = fgm.composition.materials.len();
     if spec.palette.len() != n {
         return Err(Error::invalid(format!(
@@ -84,13 +95,34 @@ pub fn write(fgm: &Fgm, dir: &Path, spec: &StackSpec, progress: &Progress) -> Re
             "the stack would be {layers} pictures of {width} × {height} pixels; lower --dpi or thicken --layer"
         )));
     }
+    Ok(Plan {
+        corner: b.min,
+        px,
+        width,
+        height,
+        layers,
+        top: b.max[1],
+    })
+}
+
+/// Writes the stack of `fgm` into the folder `dir` (replaced whole when done).
+pub fn write(fgm: &Fgm, dir: &Path, spec: &StackSpec, progress: &Progress) -> Result<StackReport> {
+    let n = fgm.composition.materials.len();
+    let Plan {
+        corner,
+        px,
+        width,
+        height,
+        layers,
+        top,
+    } = plan(fgm, spec)?;
     let out = AtomicDir::create(dir)?;
     let counter = progress.counter(layers as u64, "layers");
     let results: Vec<Result<LayerCounts>> = (0..layers)
         .into_par_iter()
         .map(|l| {
-            let z = b.min[2] + (l as f64 + 0.5) * spec.layer;
-            let r = layer(fgm, spec, [b.min[0], b.max[1]], px, width, height, z);
+            let z = corner[2] + (l as f64 + 0.5) * spec.layer;
+            let r = layer(fgm, spec, [corner[0], top], px, width, height, z);
             let (rgba, counts, sums, inside) = r;
             let path = out.file(&format!("layer_{l:05}.png"));
             crate::io::png::write_rgba(&path, width as u32, height as u32, &rgba)?;
@@ -123,7 +155,7 @@ pub fn write(fgm: &Fgm, dir: &Path, spec: &StackSpec, progress: &Progress) -> Re
         height,
         pixel_mm: px,
         layer_mm: spec.layer,
-        origin: [b.min[0], b.min[1], b.min[2]],
+        origin: corner,
         part_pixels,
         shares: counts
             .iter()
