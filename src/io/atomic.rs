@@ -19,8 +19,11 @@ pub fn check_writable(path: &Path) -> Result<()> {
             path.display()
         )));
     }
+    // Named as `path`'s own temporaries are, so that a probe a killed run leaves behind is
+    // removed with them (`remove_stale_temporaries`).
     tempfile::Builder::new()
-        .prefix(".latvox-probe-")
+        .prefix(&temp_prefix(path))
+        .rand_bytes(RANDOM_LEN)
         .tempfile_in(dir)
         .map(drop)
         .map_err(|e| folder_error(path, e))
