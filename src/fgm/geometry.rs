@@ -94,6 +94,16 @@ impl<'a> ScanSdf<'a> {
         p0.map(|x| x + 3.5 * self.spec.voxel)
     }
 
+    /// The block at position `i` of the lattice (x slowest, z fastest).
+    fn block_at(&self, i: usize) -> [i64; 3] {
+        let (i, [_, ny, nz]) = (i as i64, self.n);
+        [
+            self.lo[0] + i / (ny * nz),
+            self.lo[1] + (i / nz) % ny,
+            self.lo[2] + i % nz,
+        ]
+    }
+
     fn block_index(&self, b: [i64; 3]) -> Option<usize> {
         let r = [0, 1, 2].map(|a| b[a] - self.lo[a]);
         if (0..3).any(|a| r[a] < 0 || r[a] >= self.n[a]) {
@@ -126,13 +136,7 @@ impl<'a> ScanSdf<'a> {
         let classified: Vec<(bool, i8)> = (0..total)
             .into_par_iter()
             .map(|i| {
-                let i = i as i64;
-                let b = [
-                    self.lo[0] + i / (ny * nz),
-                    self.lo[1] + (i / nz) % ny,
-                    self.lo[2] + i % nz,
-                ];
-                let c = self.block_centre(b);
+                let c = self.block_centre(self.block_at(i));
                 let (k, u) = self.cloud.nearest_one(&c);
                 let near = u - self.trust(k) <= reach;
                 let sign = match &self.winding {
@@ -159,13 +163,7 @@ impl<'a> ScanSdf<'a> {
             .into_par_iter()
             .map(|i| match test[i] {
                 0 => {
-                    let i = i as i64;
-                    let b = [
-                        self.lo[0] + i / (ny * nz),
-                        self.lo[1] + (i / nz) % ny,
-                        self.lo[2] + i % nz,
-                    ];
-                    let c = self.block_centre(b);
+                    let c = self.block_centre(self.block_at(i));
                     let nearest: Vec<(usize, f64)> = self.cloud.nearest(&c, NEIGHBOURS).collect();
                     self.near_value(c, &nearest).0 < 0.0
                 }

@@ -342,18 +342,24 @@ fn package(
     w.write_all(&buf)
 }
 
-/// Writes a 3MF package with one mesh object and one build item.
-pub fn write(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
-    if let Some(t) = mesh
+/// 3MF forbids a triangle that repeats a vertex: the first one is refused.
+fn refuse_degenerate(mesh: &Mesh) -> std::io::Result<()> {
+    match mesh
         .indices
         .chunks_exact(3)
         .position(|t| t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
     {
-        return Err(std::io::Error::new(
+        Some(t) => Err(std::io::Error::new(
             std::io::ErrorKind::InvalidData,
             format!("3MF forbids degenerate triangles and triangle {t} repeats a vertex (run `latvox repair`)"),
-        ));
+        )),
+        None => Ok(()),
     }
+}
+
+/// Writes a 3MF package with one mesh object and one build item.
+pub fn write(mesh: &Mesh, w: &mut dyn Write) -> std::io::Result<()> {
+    refuse_degenerate(mesh)?;
     package(w, |x| {
         x.write_all(model_head().as_bytes())?;
         for p in mesh.positions.chunks_exact(3) {
@@ -388,16 +394,7 @@ pub struct Composites<'a> {
 /// vertices' compositions (`p1 p2 p3`), so that a slicer that reads the Materials extension
 /// mixes the materials as graded.
 pub fn write_composites(mesh: &Mesh, c: &Composites, w: &mut dyn Write) -> std::io::Result<()> {
-    if let Some(t) = mesh
-        .indices
-        .chunks_exact(3)
-        .position(|t| t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
-    {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!("3MF forbids degenerate triangles and triangle {t} repeats a vertex"),
-        ));
-    }
+    refuse_degenerate(mesh)?;
     let mut index = std::collections::HashMap::new();
     let mut composites: Vec<Vec<u32>> = Vec::new();
     let per_vertex: Vec<u32> = c
