@@ -836,3 +836,253 @@ fn meshes_curves_surfaces_weights_and_the_preview() {
         .count();
     assert!(coloured > 100_000, "{coloured} coloured pixels");
 }
+
+/// A plane contour: the cam of the implicit FGM literature's example (a base circle of 20 mm
+/// with a lobe, `r(θ) = 20 + 8 max(0, cos θ)²`) about (3.1, −4.7), with a 6 mm bore; or a
+/// circle of 10 mm. Signed distances computed here: the circle's exactly, the cam's from a
+/// polygon of 7200 vertices (distance to its edges, sign by containment).
+struct Contour {
+    bore: bool,
+    cam: Vec<[f64; 2]>,
+}
+
+const CAM_C: [f64; 2] = [3.1, -4.7];
+
+impl Contour {
+    fn new(bore: bool) -> Contour {
+        let cam = (0..7200)
+            .map(|k| {
+                let [x, y, _] = Contour::cam_at(k as f64 / 7200.0);
+                [x, y]
+            })
+            .collect();
+        Contour { bore, cam }
+    }
+
+    /// The cam's profile at parameter `t` ∈ [0, 1) and its outward normal (x, y, 0 / 2D).
+    fn cam_at(t: f64) -> [f64; 3] {
+        let a = 2.0 * PI * t;
+        let r = 20.0 + 8.0 * a.cos().max(0.0).powi(2);
+        [CAM_C[0] + r * a.cos(), CAM_C[1] + r * a.sin(), 0.0]
+    }
+
+    /// Signed distance to the part (negative inside).
+    fn distance(&self, p: [f64; 2]) -> f64 {
+        let n = self.cam.len();
+        let mut d = f64::INFINITY;
+        let mut inside = false;
+        for k in 0..n {
+            let (a, b) = (self.cam[k], self.cam[(k + 1) % n]);
+            let ab = [b[0] - a[0], b[1] - a[1]];
+            let t = (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1])
+                / (ab[0] * ab[0] + ab[1] * ab[1]))
+                .clamp(0.0, 1.0);
+            d = d.min(
+                ((p[0] - a[0] - t * ab[0]).powi(2) + (p[1] - a[1] - t * ab[1]).powi(2)).sqrt(),
+            );
+            if (a[1] > p[1]) != (b[1] > p[1]) && p[0] < a[0] + (p[1] - a[1]) / (b[1] - a[1]) * ab[0]
+            {
+                inside = !inside;
+            }
+        }
+        let cam = if inside { -d } else { d };
+        if !self.bore {
+            return cam;
+        }
+        let bore = ((p[0] - CAM_C[0]).powi(2) + (p[1] - CAM_C[1]).powi(2)).sqrt() - 6.0;
+        cam.max(-bore)
+    }
+
+    fn area(&self) -> f64 {
+        let n = self.cam.len();
+        let cam: f64 = (0..n)
+            .map(|k| {
+                let (a, b) = (self.cam[k], self.cam[(k + 1) % n]);
+                a[0] * b[1] - b[0] * a[1]
+            })
+            .sum::<f64>()
+            / 2.0;
+        cam - if self.bore { PI * 36.0 } else { 0.0 }
+    }
+
+    /// `n` points of the profile (and a sixth as many on the bore), moved along the normal by up
+    /// to `noise`, less the arc `gap` (a fraction of the profile) from the top.
+    fn scan(&self, n: usize, noise: f64, gap: f64, seed: u64) -> Vec<[f64; 2]> {
+        let mut rng = Rng(seed);
+        let mut out = Vec::new();
+        for k in 0..n {
+            let t = (k as f64 + 0.5) / n as f64;
+            if (t - 0.25).abs() < gap / 2.0 {
+                continue;
+            }
+            let (p, q) = (Contour::cam_at(t), Contour::cam_at(t + 1e-6));
+            let tangent = [q[0] - p[0], q[1] - p[1]];
+            let l = (tangent[0] * tangent[0] + tangent[1] * tangent[1]).sqrt();
+            let e = rng.uniform(-noise, noise);
+            out.push([p[0] + e * tangent[1] / l, p[1] - e * tangent[0] / l]);
+        }
+        if self.bore {
+            for k in 0..n / 6 {
+                let a = 2.0 * PI * k as f64 / (n / 6) as f64;
+                out.push([CAM_C[0] + 6.0 * a.cos(), CAM_C[1] + 6.0 * a.sin()]);
+            }
+        }
+        out
+    }
+}
+
+/// The signed distance image a run wrote: the grid (x0, y0, h) and the rows.
+fn read_image(path: &Path) -> ([f64; 3], Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let header = text.lines().find(|l| l.contains("x0 =")).unwrap();
+    let value = |name: &str| -> f64 {
+        header
+            .trim_start_matches('#')
+            .split(',')
+            .find_map(|kv| {
+                let (k, v) = kv.split_once('=')?;
+                (k.trim() == name).then(|| v.trim().parse().unwrap())
+            })
+            .unwrap()
+    };
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), value("rows") as usize);
+    assert!(rows.iter().all(|r| r.len() == value("columns") as usize));
+    ([value("x0"), value("y0"), value("h")], rows)
+}
+
+/// `fgm --2d`: a cam's profile (clean, with 1 % noise, with a 10 % gap; with a bore, a second
+/// loop whose orientation must be found) and its signed distance image: within half a node
+/// spacing of the distance computed here near the outline, the right sign everywhere else (by
+/// winding numbers and by line scans), the outline's area and loops, the composition's area
+/// shares (graded linearly from the skin: the mean depth over d_max, computed here from the
+/// analytic distance), the SVG's loops and the preview's colours.
+#[test]
+fn plane_contours_give_a_signed_distance_image() {
+    let dir = tempdir();
+    let d = dir.path();
+    let cases = [
+        (true, 0.0, 0.0, "winding", 0.5),
+        (true, 0.0, 0.0, "scan", 0.35),
+        (false, 0.2, 0.0, "winding", 0.5),
+        (true, 0.0, 0.1, "winding", 0.5),
+    ];
+    for (bore, noise, gap, sign, h) in cases {
+        let c = Contour::new(bore);
+        let label = format!("bore {bore} noise {noise} gap {gap} sign {sign} h {h}");
+        let text: String = c
+            .scan(900, noise, gap, 3)
+            .iter()
+            .map(|p| format!("{:.5} {:.5}\n", p[0], p[1]))
+            .collect();
+        std::fs::write(d.join("cam.xy"), text).unwrap();
+        ok(
+            &[
+                "fgm",
+                "--2d",
+                "--points",
+                "cam.xy",
+                "--voxel",
+                &h.to_string(),
+                "--sign",
+                sign,
+                "-o",
+                "cam.csv",
+                "--svg",
+                "cam.svg",
+                "--preview",
+                "cam.png",
+                "--report",
+                "cam.json",
+            ],
+            d,
+        );
+        let ([x0, y0, hh], rows) = read_image(&d.join("cam.csv"));
+        assert_eq!(hh, h);
+        let (mut worst, mut wrong, mut depth_sum, mut inside) = (0.0f64, 0, 0.0, 0usize);
+        let in_gap =
+            |p: [f64; 2]| gap > 0.0 && p[1] - CAM_C[1] > 10.0 && (p[0] - CAM_C[0]).abs() < 12.0;
+        for (j, row) in rows.iter().enumerate() {
+            for (i, v) in row.iter().enumerate() {
+                let p = [x0 + i as f64 * h, y0 + j as f64 * h];
+                let exact = c.distance(p);
+                if exact < 0.0 {
+                    depth_sum += -exact;
+                    inside += 1;
+                }
+                if in_gap(p) {
+                    continue;
+                }
+                if exact.abs() < 1.5 * h {
+                    worst = worst.max((v - exact).abs());
+                } else if v.signum() != exact.signum() {
+                    wrong += 1;
+                }
+            }
+        }
+        let tol = 0.5 * h + noise;
+        assert!(worst < tol, "{label}: worst {worst} near the outline");
+        assert_eq!(wrong, 0, "{label}: {wrong} nodes of the wrong sign");
+        let r = json(&d.join("cam.json"));
+        let area = r["area"].as_f64().unwrap();
+        let gap_area = if gap > 0.0 { 0.02 * c.area() } else { 0.0 };
+        assert!(
+            (area - c.area()).abs() < 0.01 * c.area() + gap_area,
+            "{label}: area {area} against {}",
+            c.area()
+        );
+        assert_eq!(r["loops"], if bore { 2 } else { 1 }, "{label}");
+        let svg = std::fs::read_to_string(d.join("cam.svg")).unwrap();
+        assert_eq!(
+            svg.matches('M').count(),
+            if bore { 2 } else { 1 },
+            "{label}"
+        );
+        // Linear from the skin: material A's share is the mean depth over d_max.
+        let dmax = r["dmax"].as_f64().unwrap();
+        let share = numbers(&r["shares"])[0];
+        let expect = depth_sum / inside as f64 / dmax;
+        assert!(
+            (share - expect).abs() < 0.01,
+            "{label}: share {share} against {expect}"
+        );
+        // The preview: white in the bore, the part coloured (neither white nor black).
+        let (w, _, px) = common::read_png(&d.join("cam.png"));
+        let centre_px = |p: [f64; 2]| {
+            let span_x = (rows[0].len() - 1) as f64 * h;
+            let span_y = (rows.len() - 1) as f64 * h;
+            let scale = 560.0 / span_x.max(span_y);
+            let col = 20 + ((p[0] - x0) * scale) as usize;
+            let row = 20 + ((y0 + span_y - p[1]) * scale) as usize;
+            let k = 3 * (row * w as usize + col);
+            [px[k], px[k + 1], px[k + 2]]
+        };
+        if bore {
+            assert_eq!(centre_px(CAM_C), [255; 3], "{label}");
+        }
+        let material = centre_px([CAM_C[0] - 13.0, CAM_C[1]]);
+        assert!(
+            material != [255; 3] && material != [0; 3],
+            "{label}: {material:?}"
+        );
+    }
+    // Refused in the plane, before any file is made.
+    let before = files_in(d);
+    for (args, what) in [
+        (vec!["--vdb", "x.vdb"], "--vdb"),
+        (vec!["--feature", "surface:x.stl"], "plane contour"),
+        (vec!["--feature", "point:1,2,3"], "point:X,Y"),
+        (vec!["-o", "x.ply"], ".csv"),
+    ] {
+        let mut all = vec!["fgm", "--2d", "--points", "cam.xy", "--voxel", "1"];
+        all.extend(args);
+        let out = run(&all, d);
+        assert_refusal(d, &before, &out, &all, what);
+    }
+    let all = ["fgm", "--points", "cam.xy", "--voxel", "1", "-o", "x.ply"];
+    assert_refusal(d, &before, &run(&all, d), &all, "--2d");
+}

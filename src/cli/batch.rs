@@ -173,6 +173,14 @@ impl Task for FgmArgs {
     }
 
     fn run(&self) -> Result<TaskReport> {
+        if self.two_d {
+            let r = super::fgm::execute_plane(self, &Progress::hidden())?;
+            return Ok(TaskReport {
+                report: serde_json::to_value(&r).map_err(|e| Error::invalid(e.to_string()))?,
+                passed: true,
+                warnings: Vec::new(),
+            });
+        }
         let r = super::fgm::execute(self, &Progress::hidden())?;
         let verdict = r.checks.verdict();
         TaskReport::new(&r, &verdict, Vec::new())

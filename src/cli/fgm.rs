@@ -33,6 +33,11 @@ Examples:
   # The inside told by line scans, as the implicit FGM literature does (clean scans only)
   latvox fgm --points clean.ply --voxel 0.5 --sign scan -o part.ply
 
+  # In the plane: a cam's measured profile (x y per line) to a signed distance image (CSV
+  # matrix), its outline (SVG) and a picture graded linearly from the profile inward
+  latvox fgm --2d --points cam.csv --voxel 0.5 --feature skin -o cam.csv --svg cam.svg \
+      --preview cam.png
+
 Geometry: --points reads .xyz/.txt/.csv/.asc/.pts (x y z per line; x y z nx ny nz gives normals)
 or .ply (vertex x y z, with nx ny nz when present). Missing normals are estimated by local PCA
 and oriented by a minimum spanning tree (Hoppe et al. 1992). Near the scan the signed distance is
@@ -52,7 +57,13 @@ Materials extension's composite materials per vertex over base materials; .stl, 
 geometry only), checked closed and free of self-intersections; --vdb FILE with grids
 sdf, distance and one fog grid per material; --png-stack DIR one RGBA picture per layer, each
 pixel one material (error diffusion), outside transparent, with stack.json; --preview FILE.png a
-section (--preview-z, default mid-height) coloured by composition, with a legend.";
+section (--preview-z, default mid-height) coloured by composition, with a legend.
+
+--2d: the points are a closed contour in a plane (x y per line; x y nx ny with normals): the
+same field in the plane, sampled at the nodes x0 + i·h, y0 + j·h. Outputs: -o FILE.csv the
+signed distance image (one row per line, lowest y first), --svg the outline (the zero
+iso-line, by marching squares), --preview the image coloured by composition; features
+point:X,Y, curve:FILE (x y per line) and skin.";
 
 /// Default colours, one per material in order.
 const PALETTE: [[u8; 3]; 6] = [
@@ -74,6 +85,9 @@ pub struct FgmArgs {
         conflicts_with = "mesh"
     )]
     pub points: Option<PathBuf>,
+    /// The points are a closed contour in a plane (x y per line): a signed distance image.
+    #[arg(long = "2d", requires = "points")]
+    pub two_d: bool,
     /// The part as a closed mesh (.stl, .obj, .off, .ply, .3mf).
     #[arg(long, value_name = "FILE")]
     pub mesh: Option<PathBuf>,
@@ -104,9 +118,13 @@ pub struct FgmArgs {
     #[arg(long, value_name = "#RGB,#RGB,…")]
     pub palette: Option<String>,
     /// The part's mesh: .ply (vertex colours), .3mf (composite materials per vertex), .stl,
-    /// .obj or .off.
-    #[arg(long, short = 'o', value_name = "FILE", default_value = "fgm.ply")]
-    pub output: PathBuf,
+    /// .obj or .off [default: fgm.ply]; with --2d, the signed distance image, .csv [default:
+    /// fgm.csv].
+    #[arg(long, short = 'o', value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// With --2d: the outline (the zero iso-line) as SVG.
+    #[arg(long, value_name = "FILE.svg", requires = "two_d")]
+    pub svg: Option<PathBuf>,
     /// A .vdb with grids sdf, distance and one per material.
     #[arg(long, value_name = "FILE.vdb")]
     pub vdb: Option<PathBuf>,
@@ -200,7 +218,7 @@ impl FgmArgs {
         let list = self
             .feature
             .iter()
-            .map(|f| Feature::parse(f))
+            .map(|f| Feature::parse(f, self.two_d))
             .collect::<Result<Vec<_>>>()?;
         let weights = match &self.weights {
             None => None,
@@ -244,7 +262,10 @@ impl FgmArgs {
         let features = self.features()?;
         let (geometry, input_name, bounds) = match (&self.points, &self.mesh) {
             (Some(p), _) => {
-                let cloud = latvox::io::points::read(p)?;
+                let cloud = match self.two_d {
+                    true => latvox::io::points::read_plane(p)?,
+                    false => latvox::io::points::read(p)?,
+                };
                 if cloud.points.is_empty() {
                     return Err(Error::invalid(format!("{}: no points", p.display())));
                 }
@@ -256,7 +277,11 @@ impl FgmArgs {
                         hi[a] = hi[a].max(q[a]);
                     }
                 }
-                (Geometry::Points(cloud), p.display().to_string(), (lo, hi))
+                let geometry = match self.two_d {
+                    true => Geometry::Contour(cloud),
+                    false => Geometry::Points(cloud),
+                };
+                (geometry, p.display().to_string(), (lo, hi))
             }
             (None, Some(m)) => {
                 let mesh = latvox::io::read(m, &ReadOptions::default())?.mesh;
@@ -344,9 +369,18 @@ fn write_mesh(
     })
 }
 
+impl FgmArgs {
+    /// The main output: `-o`, or its default.
+    pub fn output(&self) -> PathBuf {
+        let default = if self.two_d { "fgm.csv" } else { "fgm.ply" };
+        self.output.clone().unwrap_or_else(|| default.into())
+    }
+}
+
 /// The files a run writes.
 pub fn outputs(a: &FgmArgs) -> Vec<PathBuf> {
-    let mut v = vec![a.output.clone()];
+    let mut v = vec![a.output()];
+    v.extend(a.svg.clone());
     v.extend(a.vdb.clone());
     v.extend(a.png_stack.clone());
     v.extend(a.preview.clone());
@@ -357,6 +391,17 @@ pub fn run(a: &FgmArgs, quiet: bool) -> Result<i32> {
     let progress = Progress::new(quiet || a.json);
     if let Some(r) = &a.report {
         latvox::io::atomic::check_writable(r)?;
+    }
+    if a.two_d {
+        let report = execute_plane(a, &progress)?;
+        if let Some(r) = &a.report {
+            write_json(r, &report)?;
+        }
+        match a.json {
+            true => super::out::json(&report),
+            false => print_plane_summary(&report),
+        }
+        return Ok(0);
     }
     let report = execute(a, &progress)?;
     if let Some(r) = &a.report {
@@ -370,10 +415,146 @@ pub fn run(a: &FgmArgs, quiet: bool) -> Result<i32> {
     Ok(report.checks.verdict().exit_code())
 }
 
+/// The report of an `fgm --2d` run.
+#[derive(serde::Serialize)]
+pub struct PlaneReport {
+    input: String,
+    geometry: latvox::fgm::job::GeometryReport,
+    /// Nodes of the signed distance image along x and y.
+    image: [usize; 2],
+    /// The node (0, 0), mm.
+    origin: [f64; 2],
+    features: Vec<&'static str>,
+    composition: Composition,
+    dmax: f64,
+    shares: Vec<f64>,
+    /// The outline's loops and the area they enclose, mm².
+    loops: usize,
+    area: f64,
+    outputs: Vec<String>,
+    timings: serde_json::Map<String, serde_json::Value>,
+}
+
+/// Makes a plane contour's signed distance image and writes its files.
+pub fn execute_plane(a: &FgmArgs, progress: &Progress) -> Result<PlaneReport> {
+    let output = a.output();
+    let ext = output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    if ext.as_deref() != Some("csv") {
+        return Err(Error::invalid(format!(
+            "{}: with --2d, -o is the signed distance image, a .csv (the outline: --svg)",
+            output.display()
+        )));
+    }
+    for (given, what) in [
+        (a.vdb.is_some(), "--vdb"),
+        (a.png_stack.is_some(), "--png-stack"),
+        (a.preview_z.is_some(), "--preview-z"),
+    ] {
+        if given {
+            return Err(Error::invalid(format!(
+                "{what} makes no sense for a plane contour (--2d)"
+            )));
+        }
+    }
+    latvox::io::atomic::check_writable(&output)?;
+    for p in a.svg.iter().chain(&a.preview) {
+        latvox::io::atomic::check_writable(p)?;
+    }
+    let job = a.job()?;
+    let palette = a.palette(job.composition.materials.len())?;
+    let part = job.run_plane(progress)?;
+    let mut timings = serde_json::Map::new();
+    for (k, v) in &part.timings {
+        timings.insert(k.to_string(), (*v).into());
+    }
+    let t = std::time::Instant::now();
+    latvox::io::atomic::write_atomic(&output, |w| part.write_csv(w))?;
+    let mut outputs = vec![output.display().to_string()];
+    if let Some(p) = &a.svg {
+        latvox::io::atomic::write_atomic(p, |w| part.write_svg(w))?;
+        outputs.push(p.display().to_string());
+    }
+    if let Some(p) = &a.preview {
+        part.write_preview(p, &palette)?;
+        outputs.push(p.display().to_string());
+    }
+    timings.insert("write".into(), t.elapsed().as_secs_f64().into());
+    Ok(PlaneReport {
+        input: job.input_name.clone(),
+        geometry: part.geometry.clone(),
+        image: part.size,
+        origin: part.origin,
+        features: job.features.list.iter().map(|f| f.name()).collect(),
+        composition: part.composition.clone(),
+        dmax: part.dmax,
+        shares: part.shares(),
+        loops: part.loops.len(),
+        area: part.area(),
+        outputs,
+        timings,
+    })
+}
+
+/// The summary's material line: the features, d_max and each material's share (by `by`).
+fn print_material(features: &[&str], c: &Composition, dmax: f64, shares: &[f64], by: &str) {
+    let shares: Vec<String> = c
+        .materials
+        .iter()
+        .zip(shares)
+        .map(|(m, s)| format!("{m} {:.1} %", 100.0 * s))
+        .collect();
+    outln!(
+        "material  graded from {} · d_max {dmax:.4} mm · by {by} {}",
+        features.join(" + "),
+        shares.join(", ")
+    );
+}
+
+fn print_plane_summary(r: &PlaneReport) {
+    let g = &r.geometry;
+    outln!(
+        "{}: contour of {} points, spacing {:.4} mm, normals {} · inside by {}",
+        r.input,
+        g.points.unwrap_or(0),
+        g.point_spacing.unwrap_or(0.0),
+        if g.normals_estimated == Some(true) {
+            "estimated"
+        } else {
+            "from the file"
+        },
+        match g.sign {
+            Some(Sign::Scan) => "line scans",
+            _ => "winding numbers",
+        }
+    );
+    outln!(
+        "image     {} × {} nodes, h = {} mm, from ({:.4}, {:.4})",
+        r.image[0],
+        r.image[1],
+        g.voxel,
+        r.origin[0],
+        r.origin[1]
+    );
+    print_material(&r.features, &r.composition, r.dmax, &r.shares, "area");
+    outln!("outline   {} loop(s), area {:.3} mm²", r.loops, r.area);
+    for o in &r.outputs {
+        outln!("wrote     {o}");
+    }
+}
+
 /// Makes the part and writes its files; returns the report, for `run` to print and `latvox
 /// batch` to record.
 pub fn execute(a: &FgmArgs, progress: &Progress) -> Result<FgmReport> {
-    latvox::io::atomic::check_writable(&a.output)?;
+    let output = a.output();
+    if a.svg.is_some() {
+        return Err(Error::invalid(
+            "--svg is the outline of a plane contour (--2d)",
+        ));
+    }
+    latvox::io::atomic::check_writable(&output)?;
     for p in a.vdb.iter().chain(&a.preview) {
         latvox::io::atomic::check_writable(p)?;
     }
@@ -412,8 +593,8 @@ pub fn execute(a: &FgmArgs, progress: &Progress) -> Result<FgmReport> {
     if let Some(p) = &a.preview {
         latvox::fgm::preview::write(&fgm, p, &palette, a.preview_z)?;
     }
-    write_mesh(&a.output, &fgm, &job, &palette)?;
-    outputs.push(a.output.display().to_string());
+    write_mesh(&output, &fgm, &job, &palette)?;
+    outputs.push(output.display().to_string());
     if let Some(v) = &a.vdb {
         let _s = progress.stage("write .vdb");
         fgm.write_vdb(v)?;
@@ -480,19 +661,7 @@ fn print_summary(r: &FgmReport) {
         g.band_voxels,
         g.grid_bytes as f64 / 1e6
     );
-    let shares: Vec<String> = r
-        .composition
-        .materials
-        .iter()
-        .zip(&r.shares)
-        .map(|(m, s)| format!("{m} {:.1} %", 100.0 * s))
-        .collect();
-    outln!(
-        "material  graded from {} · d_max {:.4} mm · by volume {}",
-        r.features.join(" + "),
-        r.dmax,
-        shares.join(", ")
-    );
+    print_material(&r.features, &r.composition, r.dmax, &r.shares, "volume");
     outln!(
         "mesh      {} triangles, volume {:.2} mm³",
         r.triangles,

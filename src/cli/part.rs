@@ -40,6 +40,7 @@ const PART_KEYS: &[(&str, &[&str])] = &[
         "fgm",
         &[
             "points",
+            "2d",
             "mesh",
             "voxel",
             "sign",

@@ -13,6 +13,11 @@
 //!
 //! The area a point stands for is `π ρ² / 8`, ρ the distance to its 8th neighbour: a uniform
 //! sample with one point per `s²` has about 8 other points within ρ when `π ρ² ≈ 8 s²`.
+//!
+//! A **plane contour** (points at `z = 0` sampling a closed curve, [`Cloud::in_plane`]) is the
+//! same with one dimension less: normals in the plane (the least-variance direction of the
+//! neighbours within it), the walk started from the contour's point of largest `y`, and each
+//! point standing for a length `2ρ / 8` of the curve.
 
 use crate::error::{Error, Result};
 use crate::field::Vec3;
@@ -45,6 +50,8 @@ pub struct Cloud {
     pub normals_estimated: bool,
     /// Whether the normals (given or estimated) had to be flipped to point outward.
     pub normals_flipped: bool,
+    /// A plane contour (points at `z = 0`, normals in the plane, `area` a length).
+    pub planar: bool,
     tree: ImmutableKdTree<f64, 3>,
 }
 
@@ -52,6 +59,15 @@ impl Cloud {
     /// Prepares `cloud`: refuses one with too few points to decide a sign from, estimates and
     /// orients normals the file lacks.
     pub fn new(cloud: PointCloud) -> Result<Cloud> {
+        Cloud::prepare(cloud, false)
+    }
+
+    /// Prepares a plane contour: points at `z = 0` (and normals, if given, in the plane).
+    pub fn in_plane(cloud: PointCloud) -> Result<Cloud> {
+        Cloud::prepare(cloud, true)
+    }
+
+    fn prepare(cloud: PointCloud, planar: bool) -> Result<Cloud> {
         let PointCloud { points, normals } = cloud;
         if points.is_empty() {
             return Err(Error::invalid("the point cloud is empty"));
@@ -100,14 +116,18 @@ impl Cloud {
             .unzip();
         let area: Vec<f64> = spacing
             .iter()
-            .map(|r| std::f64::consts::PI * r * r / SPACING_NEIGHBOURS as f64)
+            .map(|r| match planar {
+                true => 2.0 * r / SPACING_NEIGHBOURS as f64,
+                false => std::f64::consts::PI * r * r / SPACING_NEIGHBOURS as f64,
+            })
             .collect();
         let normals_estimated = normals.is_none();
         let normals = match normals {
             Some(n) => n,
             None => {
-                let mut n = pca_normals(&points, &neighbours);
-                orient(&points, &neighbours, &mut n);
+                let mut n = pca_normals(&points, &neighbours, planar);
+                let pieces = orient(&points, &neighbours, &mut n, if planar { 1 } else { 2 });
+                orient_pieces(&points, &area, &mut n, &pieces, planar);
                 n
             }
         };
@@ -124,6 +144,7 @@ impl Cloud {
             area,
             normals_estimated,
             normals_flipped: false,
+            planar,
             tree,
         };
         if cloud.enclosed_volume() < 0.0 {
@@ -136,7 +157,8 @@ impl Cloud {
     }
 
     /// The volume the oriented points enclose, `⅓ Σ aᵢ pᵢ·nᵢ` (positive for outward normals),
-    /// taken about the cloud's centroid so that it does not depend on where the part lies.
+    /// taken about the cloud's centroid so that it does not depend on where the part lies; a
+    /// plane contour's area, `½ Σ aᵢ pᵢ·nᵢ`.
     pub fn enclosed_volume(&self) -> f64 {
         let c = self.centroid();
         self.points
@@ -147,7 +169,7 @@ impl Cloud {
                 a * ((p[0] - c[0]) * n[0] + (p[1] - c[1]) * n[1] + (p[2] - c[2]) * n[2])
             })
             .sum::<f64>()
-            / 3.0
+            / if self.planar { 2.0 } else { 3.0 }
     }
 
     /// The mean of the points.
@@ -189,8 +211,9 @@ impl Cloud {
     }
 }
 
-/// Each point's least-variance direction among its neighbours (unoriented).
-fn pca_normals(points: &[Vec3], neighbours: &[Vec<u32>]) -> Vec<Vec3> {
+/// Each point's least-variance direction among its neighbours (unoriented); within the plane
+/// `z = 0` when `planar`.
+fn pca_normals(points: &[Vec3], neighbours: &[Vec<u32>], planar: bool) -> Vec<Vec3> {
     neighbours
         .par_iter()
         .map(|near| {
@@ -211,6 +234,10 @@ fn pca_normals(points: &[Vec3], neighbours: &[Vec<u32>]) -> Vec<Vec3> {
                         m[i][j] += d[i] * d[j];
                     }
                 }
+            }
+            if planar {
+                // z made the direction of most variance, so the least lies in the plane.
+                m[2][2] += 1.0 + m[0][0] + m[1][1];
             }
             least_eigenvector(m)
         })
@@ -264,8 +291,9 @@ pub fn least_eigenvector(mut a: [[f64; 3]; 3]) -> Vec3 {
 }
 
 /// Orients `normals` consistently: a minimum spanning tree of the k-nearest-neighbour graph
-/// walked from each piece's highest point (Prim's algorithm), flipping as it goes.
-fn orient(points: &[Vec3], nearest: &[Vec<u32>], normals: &mut [Vec3]) {
+/// walked from each piece's highest point along axis `up` (Prim's algorithm), flipping as it
+/// goes. Returns the piece (connected component) of each point.
+fn orient(points: &[Vec3], nearest: &[Vec<u32>], normals: &mut [Vec3], up: usize) -> Vec<u32> {
     let k = SPACING_NEIGHBOURS + 1;
     let neighbours: Vec<&[u32]> = nearest.iter().map(|n| &n[..k.min(n.len())]).collect();
     // The graph made symmetric, so that a piece is walked whole from any of its points.
@@ -278,8 +306,10 @@ fn orient(points: &[Vec3], nearest: &[Vec<u32>], normals: &mut [Vec3]) {
         }
     }
     let mut order: Vec<usize> = (0..points.len()).collect();
-    order.sort_by(|&a, &b| points[b][2].total_cmp(&points[a][2]));
+    order.sort_by(|&a, &b| points[b][up].total_cmp(&points[a][up]));
     let mut done = vec![false; points.len()];
+    let mut piece = vec![0u32; points.len()];
+    let mut pieces = 0u32;
     let dot = |a: &Vec3, b: &Vec3| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     // Max-heap on −weight: (weight as ordered bits, to, from).
     let mut heap: BinaryHeap<(std::cmp::Reverse<u64>, u32, u32)> = BinaryHeap::new();
@@ -287,10 +317,11 @@ fn orient(points: &[Vec3], nearest: &[Vec<u32>], normals: &mut [Vec3]) {
         if done[seed] {
             continue;
         }
-        if normals[seed][2] < 0.0 {
+        if normals[seed][up] < 0.0 {
             normals[seed] = normals[seed].map(|x| -x);
         }
         done[seed] = true;
+        piece[seed] = pieces;
         let push = |heap: &mut BinaryHeap<_>, normals: &[Vec3], done: &[bool], i: usize| {
             for &j in &adjacency[i] {
                 if !done[j as usize] {
@@ -306,10 +337,86 @@ fn orient(points: &[Vec3], nearest: &[Vec<u32>], normals: &mut [Vec3]) {
                 continue;
             }
             done[j] = true;
+            piece[j] = pieces;
             if dot(&normals[j], &normals[from]) < 0.0 {
                 normals[j] = normals[j].map(|x| -x);
             }
             push(&mut heap, normals, &done, j);
+        }
+        pieces += 1;
+    }
+    piece
+}
+
+/// Pieces whose nesting is decided (the largest; the rest are left enclosing their own side).
+const NESTED_PIECES: usize = 64;
+
+/// Orients each piece of a cloud of several (a part with a cavity, a section with a bore) by
+/// how deeply it is nested: every piece first made to enclose a positive volume (area), then
+/// flipped when the other pieces wind around it an odd number of times — a cavity's outward
+/// normals point into the cavity.
+fn orient_pieces(points: &[Vec3], area: &[f64], normals: &mut [Vec3], piece: &[u32], planar: bool) {
+    let count = piece.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
+    if count < 2 {
+        return;
+    }
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); count];
+    for (i, &p) in piece.iter().enumerate() {
+        members[p as usize].push(i);
+    }
+    // Each piece enclosing a positive volume: Σ aᵢ (pᵢ − c)·nᵢ > 0 about its own centre.
+    for m in &members {
+        let mut c = [0.0; 3];
+        for &i in m {
+            for a in 0..3 {
+                c[a] += points[i][a] / m.len() as f64;
+            }
+        }
+        let v: f64 = m
+            .iter()
+            .map(|&i| {
+                area[i]
+                    * (0..3)
+                        .map(|a| (points[i][a] - c[a]) * normals[i][a])
+                        .sum::<f64>()
+            })
+            .sum();
+        if v < 0.0 {
+            for &i in m {
+                normals[i] = normals[i].map(|x| -x);
+            }
+        }
+    }
+    let mut largest: Vec<usize> = (0..count).collect();
+    largest.sort_by_key(|&p| std::cmp::Reverse(members[p].len()));
+    largest.truncate(NESTED_PIECES);
+    let full = if planar {
+        2.0 * std::f64::consts::PI
+    } else {
+        4.0 * std::f64::consts::PI
+    };
+    let dipole = if planar {
+        super::winding::dipole_2d
+    } else {
+        super::winding::dipole
+    };
+    // The nesting depth of each piece: the winding number of the others at one of its points.
+    let depth: Vec<(usize, i64)> = largest
+        .par_iter()
+        .map(|&p| {
+            let q = points[members[p][0]];
+            let w: f64 = (0..points.len())
+                .filter(|&i| piece[i] as usize != p)
+                .map(|i| dipole(&points[i], &normals[i].map(|x| x * area[i]), &q))
+                .sum();
+            (p, (w / full).round() as i64)
+        })
+        .collect();
+    for (p, d) in depth {
+        if d.rem_euclid(2) == 1 {
+            for &i in &members[p] {
+                normals[i] = normals[i].map(|x| -x);
+            }
         }
     }
 }

@@ -10,9 +10,10 @@
 //! say nothing trustworthy, and the sign comes from an inside test that looks at the whole
 //! cloud:
 //! - `Winding` (default): the generalised winding number `w` of the oriented points
-//!   ([`super::winding`]); the value is `(½ − w)·2u`, `u` the distance to the nearest point — zero
-//!   where `w = ½`, which spans a hole in the scan like a soap film, so a missing patch closes
-//!   instead of letting the outside in;
+//!   ([`super::winding`]); the value is `(½ − w)·4u` held within `±u`, `u` the distance to the
+//!   nearest point — `±u` where the winding number is clearly in or out, zero where `w = ½`,
+//!   which spans a hole in the scan like a soap film, so a missing patch closes instead of
+//!   letting the outside in;
 //! - `Scan`: the method of the implicit FGM modelling literature (cell classification and line
 //!   scans): the grid's 8³ blocks that hold the scan are boundary cells; every other block is
 //!   inside or outside by the parity of the boundary runs a line from the box (outside) crosses
@@ -69,9 +70,14 @@ impl<'a> ScanSdf<'a> {
     /// The field of `cloud` for sampling on `spec`, the inside told by `method`.
     pub fn new(cloud: &'a Cloud, spec: GridSpec, method: Sign) -> ScanSdf<'a> {
         let region = spec.padded_region();
-        let lo = region.lo.map(|x| x.div_euclid(8));
+        let mut lo = region.lo.map(|x| x.div_euclid(8));
         let hi = region.hi.map(|x| (x - 1).div_euclid(8));
-        let n = [0, 1, 2].map(|a| hi[a] - lo[a] + 1);
+        let mut n = [0, 1, 2].map(|a| hi[a] - lo[a] + 1);
+        if cloud.planar {
+            // A plane contour: one layer of blocks, taken at z = 0.
+            lo[2] = 0;
+            n[2] = 1;
+        }
         let winding = (method == Sign::Winding).then(|| Winding::new(cloud));
         let mut sdf = ScanSdf {
             cloud,
@@ -88,10 +94,14 @@ impl<'a> ScanSdf<'a> {
         sdf
     }
 
-    /// The centre of block `b`, mm.
+    /// The centre of block `b`, mm (on the plane `z = 0` for a plane contour).
     fn block_centre(&self, b: [i64; 3]) -> Vec3 {
         let p0 = self.spec.point(b.map(|c| c * 8));
-        p0.map(|x| x + 3.5 * self.spec.voxel)
+        let mut c = p0.map(|x| x + 3.5 * self.spec.voxel);
+        if self.cloud.planar {
+            c[2] = 0.0;
+        }
+        c
     }
 
     /// The block at position `i` of the lattice (x slowest, z fastest).
@@ -113,9 +123,13 @@ impl<'a> ScanSdf<'a> {
     }
 
     fn block_of(&self, p: Vec3) -> [i64; 3] {
-        [0, 1, 2].map(|a| {
+        let mut b = [0, 1, 2].map(|a| {
             (((p[a] - self.spec.origin[a]) / self.spec.voxel - 0.5).floor() as i64).div_euclid(8)
-        })
+        });
+        if self.cloud.planar {
+            b[2] = 0;
+        }
+        b
     }
 
     /// How far from the nearest point the tangent planes are trusted, mm.
@@ -151,22 +165,28 @@ impl<'a> ScanSdf<'a> {
             .iter()
             .map(|&(near, s)| if near { 0 } else { s })
             .collect();
+        // Near the scan the sign is the tangent planes' at the block's centre (for the line
+        // scans, and for the blocks the narrow band misses when they are decided by them).
+        let tangent: Vec<bool> = (0..total)
+            .into_par_iter()
+            .map(|i| {
+                self.method == Sign::Scan && classified[i].0 && {
+                    let c = self.block_centre(self.block_at(i));
+                    let nearest: Vec<(usize, f64)> = self.cloud.nearest(&c, NEIGHBOURS).collect();
+                    self.near_value(c, &nearest).0 < 0.0
+                }
+            })
+            .collect();
         if self.method == Sign::Scan {
-            self.scan_lines();
+            self.scan_lines(&tangent);
         }
         let test: Vec<i8> = match self.method {
             Sign::Winding => classified.iter().map(|c| c.1).collect(),
             Sign::Scan => self.signs.clone(),
         };
-        // Near the scan the line scans leave the sign open: the tangent planes' there.
         self.inside = (0..total)
-            .into_par_iter()
             .map(|i| match test[i] {
-                0 => {
-                    let c = self.block_centre(self.block_at(i));
-                    let nearest: Vec<(usize, f64)> = self.cloud.nearest(&c, NEIGHBOURS).collect();
-                    self.near_value(c, &nearest).0 < 0.0
-                }
+                0 => tangent[i],
                 s => s > 0,
             })
             .collect();
@@ -200,20 +220,23 @@ impl<'a> ScanSdf<'a> {
         self.films = films;
     }
 
-    /// Line scans over the block lattice: boundary blocks (near the scan) toggle the parity of
-    /// every line that crosses a run of them; a block is inside when most of its six scans
-    /// (along ±x, ±y, ±z from the box) say so.
-    fn scan_lines(&mut self) {
+    /// Line scans over the block lattice: a run of boundary blocks (near the scan) toggles the
+    /// parity of a line that crosses the surface in it — the tangent planes' sign (`tangent`)
+    /// differs between the run's first and last block; a line that only grazes the band, or
+    /// crosses a thin wall twice within it, keeps its parity. A block is inside when most of
+    /// its six scans (along ±x, ±y, ±z from the box; ±x, ±y for a plane contour) say so.
+    fn scan_lines(&mut self, tangent: &[bool]) {
         let n = self.n;
         let at = |p: [i64; 3]| ((p[0] * n[1] + p[1]) * n[2] + p[2]) as usize;
         let mut votes = vec![0i8; self.signs.len()];
-        for axis in 0..3 {
+        for axis in 0..if self.cloud.planar { 2 } else { 3 } {
             let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
             for i in 0..n[u] {
                 for j in 0..n[v] {
                     for forward in [true, false] {
                         let mut inside = false;
-                        let mut on_boundary = false;
+                        // The run of boundary blocks the line is in: its first and last block.
+                        let mut run: Option<(usize, usize)> = None;
                         for s in 0..n[axis] {
                             let mut p = [0; 3];
                             p[axis] = if forward { s } else { n[axis] - 1 - s };
@@ -221,12 +244,13 @@ impl<'a> ScanSdf<'a> {
                             p[v] = j;
                             let k = at(p);
                             if self.signs[k] == 0 {
-                                if !on_boundary {
-                                    inside = !inside;
-                                    on_boundary = true;
-                                }
+                                run = Some((run.map_or(k, |r| r.0), k));
                             } else {
-                                on_boundary = false;
+                                if let Some((first, last)) = run.take() {
+                                    if tangent[first] != tangent[last] {
+                                        inside = !inside;
+                                    }
+                                }
                                 votes[k] += if inside { 1 } else { -1 };
                             }
                         }
@@ -278,11 +302,11 @@ impl<'a> ScanSdf<'a> {
         (1.0 - t) * near + t * far
     }
 
-    /// The value away from the scan: `(½ − w)·2u`, or the block's sign times `u` (in a block
+    /// The value away from the scan: `(½ − w)·4u` within `±u`, or the block's sign times `u` (in a block
     /// near the scan, which the line scans leave undecided, the tangent planes' sign).
     fn far_value(&self, q: Vec3, u: f64, near: f64) -> f64 {
         match &self.winding {
-            Some(w) => (0.5 - w.at(q)) * 2.0 * u,
+            Some(w) => ((0.5 - w.at(q)) * 4.0).clamp(-1.0, 1.0) * u,
             None => {
                 let s = self
                     .block_index(self.block_of(q))

@@ -25,6 +25,8 @@ pub enum Geometry {
     Points(PointCloud),
     /// A closed mesh.
     Mesh(Mesh),
+    /// A plane contour: points at `z = 0` ([`FgmJob::run_plane`]).
+    Contour(PointCloud),
 }
 
 /// What to make.
@@ -50,7 +52,7 @@ pub struct FgmJob {
 /// What the geometry stage found.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct GeometryReport {
-    /// `points` or `mesh`.
+    /// `points`, `mesh` or `contour`.
     pub source: &'static str,
     /// Points read (a scan).
     pub points: Option<usize>,
@@ -132,6 +134,11 @@ impl FgmJob {
                 };
                 (grid, report)
             }
+            Geometry::Contour(_) => {
+                return Err(Error::invalid(
+                    "a plane contour makes an image, not a solid",
+                ))
+            }
             Geometry::Mesh(mesh) => {
                 let b = mesh
                     .bounds()
@@ -165,7 +172,7 @@ impl FgmJob {
                 keyed.into_mesh()
             }
             // OpenVDB's own distance, which may be 0 on a sample: its own mesher.
-            Geometry::Mesh(_) => sdf.to_mesh(0.0)?,
+            Geometry::Mesh(_) | Geometry::Contour(_) => sdf.to_mesh(0.0)?,
         };
         if mesh.triangle_count() == 0 {
             return Err(Error::invalid(
@@ -234,20 +241,7 @@ impl FgmJob {
             .filter(|(_, i)| **i)
             .map(|(d, _)| *d as f64)
             .fold(0.0, f64::max);
-        let dmax = match self.dmax {
-            Some(d) if d > 0.0 && d.is_finite() => d,
-            Some(d) => {
-                return Err(Error::invalid(format!(
-                    "--dmax {d} must be a positive length in mm"
-                )))
-            }
-            None if largest > 0.0 => largest,
-            None => {
-                return Err(Error::invalid(
-                    "the distance to the features is 0 throughout the part",
-                ))
-            }
-        };
+        let dmax = choose_dmax(self.dmax, largest)?;
         self.composition.check(dmax)?;
         let distance_grid = sdf.values_like(&blocks, &distance, 0.0, false)?;
         drop(stage);
@@ -265,6 +259,20 @@ impl FgmJob {
             checks,
             timings,
         })
+    }
+}
+
+/// The distance at which a power law reaches 1: `given`, or the `largest` distance in the part.
+pub(crate) fn choose_dmax(given: Option<f64>, largest: f64) -> Result<f64> {
+    match given {
+        Some(d) if d > 0.0 && d.is_finite() => Ok(d),
+        Some(d) => Err(Error::invalid(format!(
+            "--dmax {d} must be a positive length in mm"
+        ))),
+        None if largest > 0.0 => Ok(largest),
+        None => Err(Error::invalid(
+            "the distance to the features is 0 throughout the part",
+        )),
     }
 }
 

@@ -27,11 +27,28 @@ pub enum Feature {
 
 impl Feature {
     /// Parses `point:X,Y,Z`, `curve:FILE` (a text point list, one vertex a line),
-    /// `surface:FILE` (a mesh: .stl, .obj, .off, .ply, .3mf) or `skin`.
-    pub fn parse(s: &str) -> Result<Feature> {
+    /// `surface:FILE` (a mesh: .stl, .obj, .off, .ply, .3mf) or `skin`; in the plane
+    /// (`planar`), `point:X,Y`, a curve of `x y` lines, and no surface.
+    pub fn parse(s: &str, planar: bool) -> Result<Feature> {
         let (kind, arg) = s.split_once(':').unwrap_or((s, ""));
         match kind.trim() {
             "skin" if arg.is_empty() => Ok(Feature::Skin),
+            "point" if planar => {
+                let v: Vec<f64> = arg
+                    .split(',')
+                    .map(|x| x.trim().parse::<f64>())
+                    .collect::<std::result::Result<_, _>>()
+                    .unwrap_or_default();
+                if v.len() != 2 || !v.iter().all(|x| x.is_finite()) {
+                    return Err(Error::invalid(format!(
+                        "feature '{s}': point:X,Y needs two finite numbers in the plane"
+                    )));
+                }
+                Ok(Feature::Point([v[0], v[1], 0.0]))
+            }
+            "surface" if planar => Err(Error::invalid(format!(
+                "feature '{s}': a plane contour is graded from point:X,Y, curve:FILE or skin"
+            ))),
             "point" => {
                 let v: Vec<f64> = arg
                     .split(',')
@@ -49,7 +66,10 @@ impl Feature {
             }
             "curve" => {
                 let path = Path::new(arg);
-                let pts = crate::io::points::read(path)?.points;
+                let pts = match planar {
+                    true => crate::io::points::read_plane(path)?.points,
+                    false => crate::io::points::read(path)?.points,
+                };
                 if pts.len() < 2 {
                     return Err(Error::invalid(format!(
                         "{}: a curve needs at least two points",
@@ -389,7 +409,7 @@ mod tests {
             1.0
         );
         assert!(
-            matches!(Feature::parse("line:1,2,3"), Err(e) if e.to_string().contains("unknown feature"))
+            matches!(Feature::parse("line:1,2,3", false), Err(e) if e.to_string().contains("unknown feature"))
         );
     }
 }

@@ -11,12 +11,14 @@
 //! - [`material`]: features, the distance to them, laws and compositions;
 //! - [`job`]: geometry → grid → mesh (checked) → material distance, and the `.vdb` and meshes;
 //! - [`stack`]: voxel-print PNG stacks by error diffusion;
-//! - [`preview`]: a section coloured by composition, with a legend.
+//! - [`preview`]: a section coloured by composition, with a legend;
+//! - [`plane`]: a plane contour → a signed distance image, its outline and a picture.
 
 pub mod cloud;
 pub mod geometry;
 pub mod job;
 pub mod material;
+pub mod plane;
 pub mod preview;
 pub mod stack;
 pub mod winding;

@@ -5,13 +5,14 @@
 //! against the distance to the features, from 0 to d_max.
 
 use super::job::{mix, Fgm};
+use super::material::Composition;
 use crate::error::{Error, Result};
 use crate::io::canvas::Canvas;
 use std::path::Path;
 
 /// The section's longer side, pixels.
-const SIDE: f64 = 560.0;
-const MARGIN: usize = 20;
+pub(crate) const SIDE: f64 = 560.0;
+pub(crate) const MARGIN: usize = 20;
 
 /// The section's height: `z`, or the part's mid-height; refused outside the part.
 pub fn section_height(fgm: &Fgm, z: Option<f64>) -> Result<f64> {
@@ -43,9 +44,7 @@ pub fn write(fgm: &Fgm, path: &Path, palette: &[[u8; 3]], z: Option<f64>) -> Res
         (size[1] * scale).ceil() as usize,
     );
     let n = fgm.composition.materials.len();
-    let legend = 70 + 22 * n;
-    let width = (pw + 2 * MARGIN).max(460);
-    let mut c = Canvas::new(width, ph + 2 * MARGIN + legend, [255; 3]);
+    let mut c = canvas(pw, ph, n);
     let mut pts = vec![0.0; 3 * pw];
     let (mut s, mut d) = (vec![0f32; pw], vec![0f32; pw]);
     let mut f = vec![0.0; n];
@@ -65,24 +64,45 @@ pub fn write(fgm: &Fgm, path: &Path, palette: &[[u8; 3]], z: Option<f64>) -> Res
             }
         }
     }
-    // The legend: the section's height, the materials, and the composition against distance.
+    let title = format!("section z = {}", short(z));
+    legend(&mut c, ph, &title, &fgm.composition, fgm.dmax, palette);
+    c.write_png(path)
+}
+
+/// A white canvas for a picture `pw × ph` pixels of `n` materials, with room for the legend.
+pub(crate) fn canvas(pw: usize, ph: usize, n: usize) -> Canvas {
+    let width = (pw + 2 * MARGIN).max(460);
+    Canvas::new(width, ph + 2 * MARGIN + 70 + 22 * n, [255; 3])
+}
+
+/// The legend under a picture `ph` pixels high: its title, each material's colour and name, and
+/// a bar of the composition against the distance to the features, from 0 to `dmax`.
+pub(crate) fn legend(
+    c: &mut Canvas,
+    ph: usize,
+    title: &str,
+    composition: &Composition,
+    dmax: f64,
+    palette: &[[u8; 3]],
+) {
     let top = (ph + 2 * MARGIN) as i64;
-    c.text(MARGIN as i64, top, &format!("section z = {}", short(z)), 2);
-    for (k, name) in fgm.composition.materials.iter().enumerate() {
+    c.text(MARGIN as i64, top, title, 2);
+    for (k, name) in composition.materials.iter().enumerate() {
         let y = top + 24 + 22 * k as i64;
         c.rect(MARGIN as i64, y, 16, 16, palette[k]);
         c.text(MARGIN as i64 + 24, y + 1, name, 2);
     }
+    let mut f = vec![0.0; composition.materials.len()];
     let bar_x = (MARGIN + 200) as i64;
-    let bar_w = width as i64 - bar_x - MARGIN as i64;
+    let bar_w = c.width as i64 - bar_x - MARGIN as i64;
     let bar_y = top + 24;
     for i in 0..bar_w {
-        let dist = fgm.dmax * i as f64 / (bar_w - 1).max(1) as f64;
-        fgm.fractions_at(dist, &mut f);
+        let dist = dmax * i as f64 / (bar_w - 1).max(1) as f64;
+        composition.fractions(dist, dmax, &mut f);
         c.rect(bar_x + i, bar_y, 1, 24, mix(&f, palette));
     }
     c.text(bar_x, bar_y + 30, "0", 2);
-    let right = format!("{} mm", short(fgm.dmax));
+    let right = format!("{} mm", short(dmax));
     c.text(
         bar_x + bar_w - 12 * right.chars().count() as i64,
         bar_y + 30,
@@ -90,11 +110,10 @@ pub fn write(fgm: &Fgm, path: &Path, palette: &[[u8; 3]], z: Option<f64>) -> Res
         2,
     );
     c.text(bar_x, bar_y + 52, "distance to features", 2);
-    c.write_png(path)
 }
 
 /// A number with at most three decimals, trailing zeros dropped.
-fn short(x: f64) -> String {
+pub(crate) fn short(x: f64) -> String {
     let s = format!("{x:.3}");
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }

@@ -12,6 +12,9 @@
 //! area-weighted centre `p̃` is replaced, seen from farther than `β r` (β = 2), by one dipole at
 //! `p̃` of moment `Σ aᵢ nᵢ` — the first-order far-field expansion the paper uses, accurate to a
 //! few thousandths at that distance. A query costs about the logarithm of the point count.
+//!
+//! For a plane contour the points are short oriented segments of length `aᵢ`, each subtending
+//! the angle `aᵢ (pᵢ − q)·nᵢ / |pᵢ − q|²`, summed over 2π.
 
 use super::cloud::Cloud;
 use crate::field::Vec3;
@@ -38,6 +41,8 @@ pub struct Winding {
     /// Points, area-scaled normals, in tree order.
     points: Vec<Vec3>,
     moments: Vec<Vec3>,
+    /// Angles in the plane (a contour) instead of solid angles.
+    planar: bool,
 }
 
 impl Winding {
@@ -48,6 +53,7 @@ impl Winding {
             nodes: Vec::with_capacity(2 * cloud.points.len() / LEAF + 1),
             points: Vec::new(),
             moments: Vec::new(),
+            planar: cloud.planar,
         };
         w.build(cloud, &mut order, 0);
         w.points = order.iter().map(|&i| cloud.points[i as usize]).collect();
@@ -115,6 +121,7 @@ impl Winding {
 
     /// The winding number at `q`: about 1 inside the scanned surface, 0 outside.
     pub fn at(&self, q: Vec3) -> f64 {
+        let dipole = if self.planar { dipole_2d } else { dipole };
         let mut sum = 0.0;
         let mut stack: Vec<u32> = Vec::with_capacity(64);
         stack.push(0);
@@ -132,18 +139,32 @@ impl Winding {
                 stack.extend(node.children);
             }
         }
-        sum / (4.0 * std::f64::consts::PI)
+        sum / if self.planar {
+            2.0 * std::f64::consts::PI
+        } else {
+            4.0 * std::f64::consts::PI
+        }
     }
 }
 
 /// The solid angle a dipole of moment `m` at `p` subtends at `q`.
-fn dipole(p: &Vec3, m: &Vec3, q: &Vec3) -> f64 {
+pub(crate) fn dipole(p: &Vec3, m: &Vec3, q: &Vec3) -> f64 {
     let d = [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
     let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
     if r2 == 0.0 {
         return 0.0;
     }
     (d[0] * m[0] + d[1] * m[1] + d[2] * m[2]) / (r2 * r2.sqrt())
+}
+
+/// The angle a dipole of moment `m` at `p` in the plane `z = 0` subtends at `q` there.
+pub(crate) fn dipole_2d(p: &Vec3, m: &Vec3, q: &Vec3) -> f64 {
+    let d = [p[0] - q[0], p[1] - q[1]];
+    let r2 = d[0] * d[0] + d[1] * d[1];
+    if r2 == 0.0 {
+        return 0.0;
+    }
+    (d[0] * m[0] + d[1] * m[1]) / r2
 }
 
 fn dist(a: &Vec3, b: &Vec3) -> f64 {

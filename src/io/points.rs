@@ -24,17 +24,59 @@ pub struct PointCloud {
 /// Reads a point cloud file, choosing the format by its extension (`.ply`, else text).
 pub fn read(path: &Path) -> Result<PointCloud> {
     let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let ply = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("ply"))
-        || data.starts_with(b"ply");
+    let ply = is_ply(path, &data);
     let cloud = if ply {
         parse_ply(&data)
     } else {
         parse_text(&data)
     };
     cloud.map_err(|e| e.in_file(path))
+}
+
+/// Whether a file is PLY: by its extension or its first bytes.
+fn is_ply(path: &Path, data: &[u8]) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("ply"))
+        || data.starts_with(b"ply")
+}
+
+/// Reads a plane contour: a text file of `x y` per line (columns 3–4 a normal `nx ny` when every
+/// such row holds a unit vector; a third column alone — the `z` of a section — is ignored), or
+/// a PLY whose vertices' `x y` are taken. The points come back at `z = 0`.
+pub fn read_plane(path: &Path) -> Result<PointCloud> {
+    let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let ply = is_ply(path, &data);
+    let cloud = if ply {
+        parse_ply(&data).map(|c| PointCloud {
+            points: c.points.iter().map(|p| [p[0], p[1], 0.0]).collect(),
+            normals: c
+                .normals
+                .and_then(|n| unit_normals(n.iter().map(|n| [n[0], n[1], 0.0]).collect())),
+        })
+    } else {
+        parse_text_plane(&data)
+    };
+    cloud.map_err(|e| e.in_file(path))
+}
+
+/// Parses a text plane contour (see [`read_plane`]).
+pub fn parse_text_plane(data: &[u8]) -> Result<PointCloud> {
+    let mut cloud = PointCloud::default();
+    let mut extra = Vec::new();
+    let mut all_have_extra = true;
+    each_row(data, 2, "a point of a contour needs x and y", |numbers| {
+        cloud.points.push([numbers[0], numbers[1], 0.0]);
+        if numbers.len() >= 4 {
+            extra.push([numbers[2], numbers[3], 0.0]);
+        } else {
+            all_have_extra = false;
+        }
+    })?;
+    if all_have_extra && !cloud.points.is_empty() {
+        cloud.normals = unit_normals(extra);
+    }
+    Ok(cloud)
 }
 
 /// Parses a PLY point cloud (its vertex element; faces, if any, are ignored).
@@ -68,14 +110,19 @@ pub fn parse_text(data: &[u8]) -> Result<PointCloud> {
     let mut cloud = PointCloud::default();
     let mut extra = Vec::new();
     let mut all_have_extra = true;
-    each_row(data, 3, "a point needs three coordinates", |numbers| {
-        cloud.points.push([numbers[0], numbers[1], numbers[2]]);
-        if numbers.len() >= 6 {
-            extra.push([numbers[3], numbers[4], numbers[5]]);
-        } else {
-            all_have_extra = false;
-        }
-    })?;
+    each_row(
+        data,
+        3,
+        "a point needs three coordinates (x y alone: a plane contour, for --2d)",
+        |numbers| {
+            cloud.points.push([numbers[0], numbers[1], numbers[2]]);
+            if numbers.len() >= 6 {
+                extra.push([numbers[3], numbers[4], numbers[5]]);
+            } else {
+                all_have_extra = false;
+            }
+        },
+    )?;
     if all_have_extra && !cloud.points.is_empty() {
         cloud.normals = unit_normals(extra);
     }
@@ -184,6 +231,19 @@ mod tests {
         let e = parse_text(b"0 0 0\n1 0\n").unwrap_err().to_string();
         assert!(e.contains("three coordinates"), "{e}");
         assert!(parse_text(b"").unwrap().points.is_empty());
+    }
+
+    #[test]
+    fn plane_contours_with_and_without_normals() {
+        let c = parse_text_plane(b"x,y\n0,0\n1,0\n").unwrap();
+        assert_eq!(c.points, vec![[0., 0., 0.], [1., 0., 0.]]);
+        assert!(c.normals.is_none());
+        let c = parse_text_plane(b"0 0 0 -1\n1 0 1 0\n").unwrap();
+        assert_eq!(c.normals.unwrap(), vec![[0., -1., 0.], [1., 0., 0.]]);
+        let c = parse_text_plane(b"0 0 5\n1 0 5\n").unwrap();
+        assert!(c.normals.is_none(), "a section's z is not a normal");
+        let e = parse_text_plane(b"0 0\n1\n").unwrap_err().to_string();
+        assert!(e.contains("line 2") && e.contains("x and y"), "{e}");
     }
 
     #[test]
