@@ -1070,6 +1070,35 @@ fn plane_contours_give_a_signed_distance_image() {
             "{label}: {material:?}"
         );
     }
+    // A part file makes the same image again, and so does a batch job naming it.
+    ok(
+        &[
+            "fgm",
+            "--2d",
+            "--points",
+            "cam.xy",
+            "--voxel",
+            "0.6",
+            "-o",
+            "a.csv",
+            "--save-part",
+            "a.toml",
+        ],
+        d,
+    );
+    assert!(std::fs::read_to_string(d.join("a.toml"))
+        .unwrap()
+        .contains("2d = true"));
+    ok(&["fgm", "--part", "a.toml", "-o", "b.csv"], d);
+    std::fs::write(
+        d.join("jobs.toml"),
+        "[[job]]\ncommand = \"fgm\"\npart = \"a.toml\"\noutput = \"c.csv\"\n",
+    )
+    .unwrap();
+    ok(&["batch", "jobs.toml", "-q"], d);
+    let a = std::fs::read(d.join("a.csv")).unwrap();
+    assert_eq!(a, std::fs::read(d.join("b.csv")).unwrap());
+    assert_eq!(a, std::fs::read(d.join("c.csv")).unwrap());
     // Refused in the plane, before any file is made.
     let before = files_in(d);
     for (args, what) in [
