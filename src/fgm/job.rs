@@ -199,42 +199,46 @@ impl FgmJob {
         let mut blocks = sdf.leaf_blocks();
         blocks.extend(sdf.interior_blocks());
         let h = sdf.spec.voxel;
-        let per_block: Vec<(Vec<f32>, Vec<bool>)> = blocks
-            .par_iter()
-            .map(|b| {
-                let mut pts = Vec::with_capacity(3 * 512);
-                for i in 0..8 {
-                    for j in 0..8 {
-                        for k in 0..8 {
-                            pts.extend(sdf.spec.point([b[0] + i, b[1] + j, b[2] + k]));
+        // Filled in place, a block of 512 at a time (no per-block vectors to gather).
+        let mut distance = vec![0f32; 512 * blocks.len()];
+        let mut inside = vec![false; 512 * blocks.len()];
+        distance
+            .par_chunks_mut(512)
+            .zip(inside.par_chunks_mut(512))
+            .zip(blocks.par_iter())
+            .for_each_init(
+                || {
+                    (
+                        Vec::with_capacity(3 * 512),
+                        vec![0f32; 512],
+                        vec![0f32; 512],
+                    )
+                },
+                |(pts, s, sk), ((d, ins), b)| {
+                    pts.clear();
+                    for i in 0..8 {
+                        for j in 0..8 {
+                            for k in 0..8 {
+                                pts.extend(sdf.spec.point([b[0] + i, b[1] + j, b[2] + k]));
+                            }
                         }
                     }
-                }
-                let mut s = vec![0f32; 512];
-                sdf.probe(&pts, &mut s);
-                let mut sk = vec![0f32; 512];
-                if let Some(g) = &skin {
-                    g.probe(&pts, &mut sk);
-                }
-                let band = (HALF_WIDTH * h) as f32;
-                let d: Vec<f32> = (0..512)
-                    .map(|v| {
-                        if s[v] >= band {
-                            return f32::NAN;
-                        }
-                        let p = [pts[3 * v], pts[3 * v + 1], pts[3 * v + 2]];
-                        self.features.distance(p, sk[v].abs() as f64) as f32
-                    })
-                    .collect();
-                (d, s.iter().map(|v| *v <= 0.0).collect())
-            })
-            .collect();
-        let mut distance = Vec::with_capacity(512 * blocks.len());
-        let mut inside = Vec::with_capacity(512 * blocks.len());
-        for (d, s) in per_block {
-            distance.extend(d);
-            inside.extend(s);
-        }
+                    sdf.probe(pts, s);
+                    if let Some(g) = &skin {
+                        g.probe(pts, sk);
+                    }
+                    let band = (HALF_WIDTH * h) as f32;
+                    for v in 0..512 {
+                        ins[v] = s[v] <= 0.0;
+                        d[v] = if s[v] >= band {
+                            f32::NAN
+                        } else {
+                            let p = [pts[3 * v], pts[3 * v + 1], pts[3 * v + 2]];
+                            self.features.distance(p, sk[v].abs() as f64) as f32
+                        };
+                    }
+                },
+            );
         let largest = distance
             .iter()
             .zip(&inside)
