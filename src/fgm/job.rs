@@ -82,14 +82,10 @@ pub struct Fgm {
     pub composition: Composition,
     /// Blocks of the part's voxels (first samples of the sdf's spec): its band and inside.
     pub blocks: Vec<[i64; 3]>,
-    /// The distance to the features at every voxel of `blocks` (512 a block, OpenVDB's order);
-    /// NaN outside the part beyond the band.
-    pub distance: Vec<f32>,
-    /// Whether each voxel is in the part (sdf ≤ 0).
-    pub inside: Vec<bool>,
     /// The distance at which a power law reaches 1, mm.
     pub dmax: f64,
-    /// The distance grid (for trilinear reads between voxels).
+    /// The distance to the features at every voxel of `blocks`, NaN outside the part beyond
+    /// the band (read back, block by block, wherever the fractions are needed).
     pub distance_grid: Grid,
     /// The geometry stage's report.
     pub geometry: GeometryReport,
@@ -198,15 +194,13 @@ impl FgmJob {
         };
         let mut blocks = sdf.leaf_blocks();
         blocks.extend(sdf.interior_blocks());
-        let h = sdf.spec.voxel;
-        // Filled in place, a block of 512 at a time (no per-block vectors to gather).
+        // Filled in place, a block of 512 at a time; the largest distance inside the part.
         let mut distance = vec![0f32; 512 * blocks.len()];
-        let mut inside = vec![false; 512 * blocks.len()];
-        distance
+        let band = (HALF_WIDTH * sdf.spec.voxel) as f32;
+        let largest = distance
             .par_chunks_mut(512)
-            .zip(inside.par_chunks_mut(512))
             .zip(blocks.par_iter())
-            .for_each_init(
+            .map_init(
                 || {
                     (
                         Vec::with_capacity(3 * 512),
@@ -214,37 +208,29 @@ impl FgmJob {
                         vec![0f32; 512],
                     )
                 },
-                |(pts, s, sk), ((d, ins), b)| {
-                    pts.clear();
-                    for i in 0..8 {
-                        for j in 0..8 {
-                            for k in 0..8 {
-                                pts.extend(sdf.spec.point([b[0] + i, b[1] + j, b[2] + k]));
-                            }
-                        }
-                    }
+                |(pts, s, sk), (d, b)| {
+                    block_points(&sdf.spec, *b, pts);
                     sdf.probe(pts, s);
                     if let Some(g) = &skin {
                         g.probe(pts, sk);
                     }
-                    let band = (HALF_WIDTH * h) as f32;
+                    let mut largest = 0.0f64;
                     for v in 0..512 {
-                        ins[v] = s[v] <= 0.0;
                         d[v] = if s[v] >= band {
                             f32::NAN
                         } else {
                             let p = [pts[3 * v], pts[3 * v + 1], pts[3 * v + 2]];
                             self.features.distance(p, sk[v].abs() as f64) as f32
                         };
+                        if s[v] <= 0.0 {
+                            largest = largest.max(d[v] as f64);
+                        }
                     }
+                    largest
                 },
-            );
-        let largest = distance
-            .iter()
-            .zip(&inside)
-            .filter(|(_, i)| **i)
-            .map(|(d, _)| *d as f64)
-            .fold(0.0, f64::max);
+            )
+            .reduce(|| 0.0, f64::max);
+        drop(skin);
         let dmax = choose_dmax(self.dmax, largest)?;
         self.composition.check(dmax)?;
         let distance_grid = sdf.values_like(&blocks, &distance, 0.0, false)?;
@@ -255,8 +241,6 @@ impl FgmJob {
             mesh,
             composition: self.composition.clone(),
             blocks,
-            distance,
-            inside,
             dmax,
             distance_grid,
             geometry,
@@ -294,23 +278,35 @@ fn check_size(b: &Aabb, voxel: f64) -> Result<()> {
 }
 
 impl Fgm {
+    /// The centres, signed distances and feature distances of block `b`'s voxels (OpenVDB's
+    /// order), read back from the grids.
+    fn block_values(&self, b: [i64; 3], pts: &mut Vec<f64>, s: &mut [f32], d: &mut [f32]) {
+        block_points(&self.sdf.spec, b, pts);
+        self.sdf.probe(pts, s);
+        self.distance_grid.probe(pts, d);
+    }
+
     /// The fractions of material `k` at every voxel of `blocks`, NaN outside the part.
     pub fn fraction_values(&self, k: usize) -> Vec<f32> {
         let n = self.composition.materials.len();
-        self.distance
-            .par_iter()
-            .zip(self.inside.par_iter())
-            .map_init(
-                || vec![0.0; n],
-                |f, (d, inside)| {
-                    if !*inside {
-                        return f32::NAN;
+        let mut out = vec![0f32; 512 * self.blocks.len()];
+        out.par_chunks_mut(512)
+            .zip(self.blocks.par_iter())
+            .for_each_init(
+                || (Vec::new(), vec![0f32; 512], vec![0f32; 512], vec![0.0; n]),
+                |(pts, s, d, f), (o, b)| {
+                    self.block_values(*b, pts, s, d);
+                    for v in 0..512 {
+                        o[v] = if s[v] <= 0.0 {
+                            self.composition.fractions(d[v] as f64, self.dmax, f);
+                            f[k] as f32
+                        } else {
+                            f32::NAN
+                        };
                     }
-                    self.composition.fractions(*d as f64, self.dmax, f);
-                    f[k] as f32
                 },
-            )
-            .collect()
+            );
+        out
     }
 
     /// The fractions at distance `d`, into `out`.
@@ -321,18 +317,29 @@ impl Fgm {
     /// The volume share of each material in the part (voxel count weighted).
     pub fn shares(&self) -> Vec<f64> {
         let n = self.composition.materials.len();
-        let mut sum = vec![0.0; n];
-        let mut f = vec![0.0; n];
-        let mut count = 0usize;
-        for (d, i) in self.distance.iter().zip(&self.inside) {
-            if *i {
-                self.fractions_at(*d as f64, &mut f);
-                for k in 0..n {
-                    sum[k] += f[k];
-                }
-                count += 1;
-            }
-        }
+        let (sum, count) = self
+            .blocks
+            .par_iter()
+            .map_init(
+                || (Vec::new(), vec![0f32; 512], vec![0f32; 512], vec![0.0; n]),
+                |(pts, s, d, f), b| {
+                    self.block_values(*b, pts, s, d);
+                    let mut sum = vec![0.0; n];
+                    let mut count = 0usize;
+                    for v in (0..512).filter(|&v| s[v] <= 0.0) {
+                        self.fractions_at(d[v] as f64, f);
+                        for k in 0..n {
+                            sum[k] += f[k];
+                        }
+                        count += 1;
+                    }
+                    (sum, count)
+                },
+            )
+            .reduce(
+                || (vec![0.0; n], 0),
+                |(a, i), (b, j)| (a.iter().zip(&b).map(|(x, y)| x + y).collect(), i + j),
+            );
         sum.iter().map(|s| s / count.max(1) as f64).collect()
     }
 
@@ -370,6 +377,18 @@ impl Fgm {
                 f
             })
             .collect()
+    }
+}
+
+/// The centres of block `b`'s 512 voxels on `spec` (x slowest, OpenVDB's order), into `pts`.
+fn block_points(spec: &GridSpec, b: [i64; 3], pts: &mut Vec<f64>) {
+    pts.clear();
+    for i in 0..8 {
+        for j in 0..8 {
+            for k in 0..8 {
+                pts.extend(spec.point([b[0] + i, b[1] + j, b[2] + k]));
+            }
+        }
     }
 }
 
