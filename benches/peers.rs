@@ -215,6 +215,7 @@ fn child(a: &[String]) {
                 tile: None,
                 memory: None,
                 keep_fragments: false,
+                grading: None,
             };
             let mut sink =
                 latvox::io::sink::StlSink::create(&stl, latvox::io::StlFormat::Binary).unwrap();

@@ -43,10 +43,11 @@ fi
 # cleaned fields), gmsh (OpenCASCADE reads the IGES back), ezdxf (reads the DXF back),
 # trimesh with networkx and lxml (an independent mesh analyser for check/repair), shapely
 # (checks every slice layer's polygons), Playwright (drives Debian's Chromium through the
-# browser editor's page; it uses that browser and downloads none of its own), and libigl (the
-# peer of the FGM benchmark: its fast winding numbers for point clouds).
-PY_PKGS=(numpy scipy gmsh ezdxf trimesh networkx lxml lib3mf shapely playwright libigl)
-PY_IMPORTS="import numpy, scipy, gmsh, ezdxf, trimesh, networkx, lxml, lib3mf, shapely, playwright, igl"
+# browser editor's page; it uses that browser and downloads none of its own), libigl (the
+# peer of the FGM benchmark: its fast winding numbers for point clouds), and manifold3d (cuts a
+# graded part at its cells' faces to measure each cell's density).
+PY_PKGS=(numpy scipy gmsh ezdxf trimesh networkx lxml lib3mf shapely playwright libigl manifold3d)
+PY_IMPORTS="import numpy, scipy, gmsh, ezdxf, trimesh, networkx, lxml, lib3mf, shapely, playwright, igl, manifold3d"
 if python3 -c "$PY_IMPORTS" 2>/dev/null; then
   echo "install-deps: Python packages present" >&2
 else

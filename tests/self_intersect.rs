@@ -86,6 +86,7 @@ fn tpms_mesh(surface: Surface, structure: Structure, cells: u32, resolution: u32
         tile: None,
         memory: None,
         keep_fragments: false,
+        grading: None,
     };
     job.run(&Progress::hidden()).unwrap().0
 }

@@ -19,7 +19,18 @@ use std::path::Path;
 /// The options that define a part, per subcommand (beside [`COMMON`]): everything but where
 /// its files go.
 const PART_KEYS: &[(&str, &[&str])] = &[
-    ("tpms", &["type", "structure", "density", "allow-islands"]),
+    (
+        "tpms",
+        &[
+            "type",
+            "structure",
+            "density",
+            "density-grade",
+            "density-field",
+            "clamp",
+            "allow-islands",
+        ],
+    ),
     ("strut", &["cell", "density", "radius", "blend"]),
     (
         "fill",
@@ -62,6 +73,15 @@ const LATTICES: &[&str] = &["tpms", "strut", "fill"];
 /// Options naming files that define the part (the mesh filled, the solids kept, the scan):
 /// saved as absolute paths, so that the part file makes the same part from any folder.
 const PATHS: &[&str] = &["input", "keep", "points", "mesh"];
+
+/// Whether the value of `key` names a file: an option of [`PATHS`], a cell file, a sampled
+/// density field.
+fn names_file(key: &str, value: &str) -> bool {
+    let v = value.to_ascii_lowercase();
+    PATHS.contains(&key)
+        || (key == "cell" && v.ends_with(".json"))
+        || (key == "density-field" && v.ends_with(".npy"))
+}
 
 /// Options that may be given several times: saved as lists.
 const REPEATED: &[&str] = &["keep", "feature", "law"];
@@ -134,8 +154,8 @@ pub fn save(
                 .display()
                 .to_string())
         };
-        if PATHS.contains(&key) {
-            for v in raw.iter_mut() {
+        for v in raw.iter_mut() {
+            if names_file(key, v) {
                 *v = full(v)?;
             }
         }
@@ -197,11 +217,8 @@ pub(crate) fn absolute(mut table: toml::Table, path: &Path) -> toml::Table {
     };
     for (key, value) in table.iter_mut() {
         let key = key.replace('_', "-");
-        let cell_file = key == "cell"
-            && value
-                .as_str()
-                .is_some_and(|c| c.to_ascii_lowercase().ends_with(".json"));
-        if PATHS.contains(&key.as_str()) || cell_file {
+        let file = value.as_str().is_some_and(|v| names_file(&key, v));
+        if PATHS.contains(&key.as_str()) || file {
             match value {
                 toml::Value::Array(items) => items.iter_mut().for_each(fix),
                 v => fix(v),
@@ -334,8 +351,7 @@ fn expand_table(
             ))
         })?;
         // Files the part file names by a relative path are relative to it.
-        let names_file = PATHS.contains(&key.as_str())
-            || (key == "cell" && arg.to_ascii_lowercase().ends_with(".json"));
+        let names_file = names_file(&key, &arg);
         let beside = |file: &str| match path.parent() {
             Some(dir) if names_file && Path::new(file).is_relative() => {
                 dir.join(file).display().to_string()

@@ -207,7 +207,7 @@ fn xy_moments(poly: &[Vec3]) -> (f64, f64) {
     (area, zint)
 }
 
-fn clipped_column_integral(tri: [Vec3; 3], b: &Aabb) -> f64 {
+pub(crate) fn clipped_column_integral(tri: [Vec3; 3], b: &Aabb) -> f64 {
     let lo = |a: usize| tri[0][a].min(tri[1][a]).min(tri[2][a]);
     let hi = |a: usize| tri[0][a].max(tri[1][a]).max(tri[2][a]);
     // Most triangles need no clipping: wholly beside the box's columns, or wholly within them
@@ -240,6 +240,19 @@ fn clipped_column_integral(tri: [Vec3; 3], b: &Aabb) -> f64 {
         }
     }
     // Part between the two planes contributes ∫(z − z0); part above contributes (z1 − z0)·A.
+    // A piece lying in the plane z = z1 would be kept by both clips: it is above.
+    let (pz0, pz1) = poly
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p[2]), b.max(p[2]))
+        });
+    if pz0 >= z1 {
+        return (z1 - z0) * xy_moments(&poly).0;
+    }
+    if pz1 <= z1 && pz0 >= z0 {
+        let (a, zint) = xy_moments(&poly);
+        return zint - z0 * a;
+    }
     let mut mid = Vec::with_capacity(8);
     clip_polygon(&poly, 2, z1, 1.0, &mut tmp);
     clip_polygon(&tmp, 2, z0, -1.0, &mut mid);

@@ -9,6 +9,7 @@
 //! reported the same way for every capability ([`report`]). [`topology`] and [`triangulate`]
 //! serve the checks and the readers.
 
+pub mod cells;
 pub mod extract;
 mod indexed;
 pub mod instance;

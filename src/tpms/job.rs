@@ -51,6 +51,8 @@ pub struct TpmsJob {
     pub memory: Option<u64>,
     /// Keep the fragments the box cuts loose from the lattice (removed by default).
     pub keep_fragments: bool,
+    /// A density that varies through the part (`density` is then not used).
+    pub grading: Option<super::graded::Grading>,
 }
 
 /// The JSON report of a TPMS job.
@@ -83,6 +85,9 @@ pub struct TpmsReport {
     pub cell_size: [f64; 3],
     /// Cells per axis (fractional where the box ends inside a cell).
     pub cells: [f64; 3],
+    /// How a graded part met its density field, cell by cell.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grading: Option<super::graded::GradingReport>,
     /// The part as written: density, mesh, checks, timings, warnings.
     #[serde(flatten)]
     pub part: PartReport,
@@ -100,6 +105,11 @@ impl TpmsJob {
     /// The part as an implicit solid, at the level the part is meshed at.
     pub fn model(&self) -> Result<crate::render::Model> {
         self.validate()?;
+        if self.grading.is_some() {
+            return Err(Error::invalid(
+                "a graded part is drawn and sliced from its mesh: make it with -o part.stl, then render, view or slice part.stl",
+            ));
+        }
         let bounds = self.domain.bounds();
         let cell = self.domain.cell;
         let min_cell = cell[0].min(cell[1]).min(cell[2]);
@@ -149,6 +159,9 @@ impl TpmsJob {
     pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<TpmsReport> {
         let start = Instant::now();
         self.validate()?;
+        if let Some(g) = &self.grading {
+            return self.run_graded(g, progress, sink);
+        }
         let (s, st) = (self.surface, self.structure);
         let range = calibrate::feasible(s, st);
         let (conn, mut warnings) = self.connectivity(range)?;
@@ -229,6 +242,7 @@ impl TpmsJob {
             thinnest_wall_voxels: wall_voxels(s, st, t0, resolved.resolution),
             cell_size: self.domain.cell,
             cells: self.domain.counts(),
+            grading: None,
             part,
         })
     }
@@ -267,7 +281,7 @@ impl TpmsJob {
 
     /// The resolution sheet walls need, when the requested one leaves them thinner than
     /// [`MIN_WALL_VOXELS`] (they perforate), and why.
-    fn thin_walls(&self, t0: f64) -> Option<(u32, String)> {
+    pub(super) fn thin_walls(&self, t0: f64) -> Option<(u32, String)> {
         let r = self.resolution;
         let w = wall_voxels(self.surface, self.structure, t0, r)?;
         (w < MIN_WALL_VOXELS).then(|| {

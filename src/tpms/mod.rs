@@ -9,6 +9,7 @@
 //! cell, so every whole cell of the part is meshed exactly like the calibration's unit cell.
 
 pub mod calibrate;
+pub mod graded;
 pub mod job;
 pub mod surface;
 

@@ -392,27 +392,86 @@ impl TpmsField {
     /// The implicit function whose zero set is the surface: `F − t` or `|F| − t`.
     #[inline(always)]
     fn implicit(&self, f: f64) -> f64 {
+        self.implicit_at(f, self.level)
+    }
+
+    /// The implicit function at level `t`.
+    #[inline(always)]
+    pub(crate) fn implicit_at(&self, f: f64, t: f64) -> f64 {
         match self.structure {
-            Structure::Net => f - self.level,
-            Structure::Sheet => f.abs() - self.level,
+            Structure::Net => f - t,
+            Structure::Sheet => f.abs() - t,
         }
     }
 
     #[inline(always)]
     fn distance(&self, f: f64, g_cell: Vec3) -> f64 {
+        self.distance_at(f, g_cell, self.level)
+    }
+
+    /// The first-order distance to the surface at level `t` from `F` and its gradient in cell
+    /// coordinates, clamped to the band.
+    #[inline(always)]
+    pub(crate) fn distance_at(&self, f: f64, g_cell: Vec3, t: f64) -> f64 {
         let g = [
             g_cell[0] / self.cell[0],
             g_cell[1] / self.cell[1],
             g_cell[2] / self.cell[2],
         ];
         let norm = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-        let v = self.implicit(f);
+        let v = self.implicit_at(f, t);
         let d = if norm > 1e-12 {
             v / norm
         } else {
             v.signum() * self.clamp
         };
         d.clamp(-self.clamp, self.clamp)
+    }
+
+    /// `F` and its gradient in cell coordinates at a world point.
+    pub(crate) fn eval_at(&self, p: Vec3) -> (f64, Vec3) {
+        self.surface.eval(self.cell_coords(p))
+    }
+
+    /// The surface's Lipschitz bound in world units (`|∇F|` per mm at most).
+    pub(crate) fn lipschitz(&self) -> f64 {
+        self.lipschitz
+    }
+
+    /// Samples a block as [`Field::sample_block`] does, at a level that may vary from sample to
+    /// sample: `level(i, j, k)` for the sample `origin + h·(i, j, k)`.
+    #[inline(always)]
+    pub(crate) fn sample_block_at(
+        &self,
+        origin: Vec3,
+        h: f64,
+        out: &mut [f32; 512],
+        level: impl Fn(usize, usize, usize) -> f64,
+    ) {
+        let mut tabs = [[AxisTable::default(); 8]; 3];
+        for (a, tab) in tabs.iter_mut().enumerate() {
+            let u = periodic::block_axis(
+                self.samples_per_cell,
+                self.origin[a],
+                self.cell[a],
+                origin[a],
+                h,
+                a,
+            );
+            for (t, u) in tab.iter_mut().zip(u) {
+                *t = AxisTable::at_turns(u);
+            }
+        }
+        let terms = self.surface.terms();
+        for i in 0..8 {
+            for j in 0..8 {
+                for k in 0..8 {
+                    let (f, g) = eval_terms(terms, &[tabs[0][i], tabs[1][j], tabs[2][k]]);
+                    let g = [g[0] * TAU, g[1] * TAU, g[2] * TAU];
+                    out[(i * 8 + j) * 8 + k] = self.distance_at(f, g, level(i, j, k)) as f32;
+                }
+            }
+        }
     }
 
     fn cell_coords(&self, p: Vec3) -> Vec3 {
@@ -457,30 +516,7 @@ impl Field for TpmsField {
     }
 
     fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
-        let mut tabs = [[AxisTable::default(); 8]; 3];
-        for (a, tab) in tabs.iter_mut().enumerate() {
-            let u = periodic::block_axis(
-                self.samples_per_cell,
-                self.origin[a],
-                self.cell[a],
-                origin[a],
-                h,
-                a,
-            );
-            for (t, u) in tab.iter_mut().zip(u) {
-                *t = AxisTable::at_turns(u);
-            }
-        }
-        let terms = self.surface.terms();
-        for i in 0..8 {
-            for j in 0..8 {
-                for k in 0..8 {
-                    let (f, g) = eval_terms(terms, &[tabs[0][i], tabs[1][j], tabs[2][k]]);
-                    let g = [g[0] * TAU, g[1] * TAU, g[2] * TAU];
-                    out[(i * 8 + j) * 8 + k] = self.distance(f, g) as f32;
-                }
-            }
-        }
+        self.sample_block_at(origin, h, out, |_, _, _| self.level)
     }
 }
 

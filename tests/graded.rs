@@ -1,0 +1,353 @@
+//! Graded TPMS lattices (`latvox tpms --density-grade / --density-field`), run as a user runs
+//! them: every whole cell's density measured by manifold3d on the written mesh (cut at the
+//! cells' faces; `checkers/cell_density.py`) against the field at the cell's centre, computed
+//! here from the field's own formula; the part closed and in one piece by manifold3d and by
+//! CGAL's checks in the report.
+
+mod common;
+use common::*;
+use std::path::Path;
+
+/// What manifold3d measured on a mesh.
+struct Measured {
+    status: String,
+    components: u64,
+    volume: f64,
+    /// `([i, j, k], fraction)` per cell.
+    cells: Vec<([usize; 3], f64)>,
+}
+
+fn measure(stl: &Path, origin: [f64; 3], cell: [f64; 3], size: [f64; 3]) -> Measured {
+    let s = |v: [f64; 3]| v.map(|x| x.to_string()).join(",");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checkers/cell_density.py");
+    let o = std::process::Command::new("python3")
+        .arg(script)
+        .arg(stl)
+        .args([s(origin), s(cell), s(size)])
+        .output()
+        .expect("python3 with manifold3d and trimesh (scripts/install-deps.sh installs them)");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    Measured {
+        status: v["status"].as_str().unwrap().to_string(),
+        components: v["components"].as_u64().unwrap(),
+        volume: v["volume"].as_f64().unwrap(),
+        cells: v["cells"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| {
+                let c = c.as_array().unwrap();
+                let i = |n: usize| c[n].as_u64().unwrap() as usize;
+                ([i(0), i(1), i(2)], c[3].as_f64().unwrap())
+            })
+            .collect(),
+    }
+}
+
+/// A graded part made by `args` (without output options), checked against `field` (the
+/// density the user asked for at a point): closed, one component, clean by CGAL, and each
+/// whole cell within ±0.01 of the field at its centre (±0.005 where the field is constant over
+/// the cell). Returns the largest whole-cell error.
+fn check_graded(
+    args: &[&str],
+    origin: [f64; 3],
+    cell: [f64; 3],
+    size: [f64; 3],
+    field: &dyn Fn([f64; 3]) -> f64,
+) -> f64 {
+    let dir = tempdir();
+    let mut all = args.to_vec();
+    all.extend([
+        "--verify",
+        "cgal",
+        "-q",
+        "-o",
+        "part.stl",
+        "--report",
+        "part.json",
+    ]);
+    ok(&all, dir.path());
+    let r = json(&dir.path().join("part.json"));
+    let checks = &r["checks"];
+    assert_eq!(checks["checked_by"], "CGAL", "{args:?}");
+    for key in ["closed", "manifold", "outward"] {
+        assert_eq!(checks[key], true, "{args:?}: {key}");
+    }
+    assert_eq!(checks["self_intersecting"], false, "{args:?}");
+    assert_eq!(r["grading"]["cells_met"], true, "{args:?}");
+    let m = measure(&dir.path().join("part.stl"), origin, cell, size);
+    assert_eq!(m.status, "Error.NoError", "{args:?}: manifold3d");
+    assert_eq!(m.components, 1, "{args:?}: one component");
+    let stl_volume = volume(&read_stl(&dir.path().join("part.stl")));
+    assert!(
+        (m.volume - stl_volume).abs() < 1e-6 * stl_volume,
+        "{args:?}"
+    );
+    let mut worst: f64 = 0.0;
+    let mut whole = 0;
+    for (c, fraction) in &m.cells {
+        let lo = [0, 1, 2].map(|a| origin[a] + c[a] as f64 * cell[a]);
+        if (0..3).any(|a| lo[a] + cell[a] > origin[a] + size[a] + 1e-9) {
+            continue;
+        }
+        whole += 1;
+        let at = |w: [f64; 3]| field([0, 1, 2].map(|a| lo[a] + w[a] * cell[a]));
+        let target = at([0.5; 3]);
+        let corners: Vec<f64> = (0..27)
+            .map(|n| at([n / 9, n / 3 % 3, n % 3].map(|q| q as f64 / 2.0)))
+            .collect();
+        let flat = corners.iter().all(|v| (v - target).abs() < 1e-9);
+        let tolerance = if flat { 0.005 } else { 0.01 };
+        let err = (fraction - target).abs();
+        assert!(
+            err <= tolerance,
+            "{args:?}: cell {c:?} has {fraction:.4}, the field asks {target:.4}"
+        );
+        worst = worst.max(err);
+    }
+    assert!(whole > 0, "{args:?}: no whole cell");
+    worst
+}
+
+/// The must-show part: a 6×6×6-cell gyroid net graded 0.1 → 0.4 along z.
+#[test]
+fn a_gyroid_graded_along_z_meets_the_grade_in_every_cell() {
+    let worst = check_graded(
+        &[
+            "tpms",
+            "--type",
+            "gyroid",
+            "--density-grade",
+            "z:0.1:0.4",
+            "--cells",
+            "6",
+            "--cell-size",
+            "5",
+            "-r",
+            "24",
+        ],
+        [0.0; 3],
+        [5.0; 3],
+        [30.0; 3],
+        &|p| 0.1 + 0.3 * p[2] / 30.0,
+    );
+    // The grade is met far inside the promise.
+    assert!(worst < 0.005, "{worst}");
+}
+
+/// An expression whose field bends within cells, where a piece the box cuts loose (and that is
+/// removed) joins again as the level rises: the correction pins the level past the jump.
+#[test]
+fn an_expression_field_is_met_cell_by_cell() {
+    check_graded(
+        &[
+            "tpms",
+            "--type",
+            "gyroid",
+            "--density-field",
+            "0.2 + 0.1*sin(PI*x/15)*cos(PI*y/15)",
+            "--cells",
+            "6,6,3",
+            "--cell-size",
+            "5",
+            "-r",
+            "24",
+        ],
+        [0.0; 3],
+        [5.0; 3],
+        [30.0, 30.0, 15.0],
+        &|p| {
+            0.2 + 0.1
+                * (std::f64::consts::PI * p[0] / 15.0).sin()
+                * (std::f64::consts::PI * p[1] / 15.0).cos()
+        },
+    );
+}
+
+/// A sheet graded along x in a box that is not a whole number of cells, at an odd origin, on
+/// coarse voxels (raised for the thinnest walls); and a field sampled in a .npy file.
+#[test]
+fn partial_cells_odd_origins_and_sampled_fields() {
+    check_graded(
+        &[
+            "tpms",
+            "--type",
+            "d",
+            "--structure",
+            "sheet",
+            "--density-grade",
+            "x:0.12:0.3",
+            "--size",
+            "23,17,12",
+            "--cell-size",
+            "6",
+            "--origin",
+            "-3.3,2.1,7",
+            "-r",
+            "16",
+        ],
+        [-3.3, 2.1, 7.0],
+        [6.0; 3],
+        [23.0, 17.0, 12.0],
+        &|p| 0.12 + 0.18 * (p[0] + 3.3) / 23.0,
+    );
+    // 3×4×5 samples spanning a 3×4×4-cell box of 5 mm: 0.25 + 0.05·j, steps along y.
+    let dir = tempdir();
+    let data: Vec<f64> = (0..60)
+        .map(|n| 0.25 + 0.05 * ((n / 5) % 4) as f64)
+        .collect();
+    let npy = dir.path().join("field.npy");
+    let mut bytes = Vec::new();
+    latvox::io::npy::write(&mut bytes, &[3, 4, 5], &data).unwrap();
+    std::fs::write(&npy, bytes).unwrap();
+    check_graded(
+        &[
+            "tpms",
+            "--type",
+            "p",
+            "--density-field",
+            npy.to_str().unwrap(),
+            "--cells",
+            "3,4,4",
+            "--cell-size",
+            "5",
+            "-r",
+            "24",
+        ],
+        [0.0; 3],
+        [5.0; 3],
+        [15.0, 20.0, 20.0],
+        // Trilinear between samples 20/3 mm apart along y.
+        &|p| 0.25 + 0.05 * (p[1] / (20.0 / 3.0)).clamp(0.0, 3.0),
+    );
+}
+
+/// Settings drawn at random (seeded): type, structure, axis, the grade's ends within the type's
+/// feasible range, cell counts, a box that may end inside a cell, an origin, a resolution.
+#[test]
+fn random_grades_are_met_in_every_whole_cell() {
+    let mut rng = Rng(0x5eed_9ade);
+    // (type, structure, lowest density that stays clear of the feasible range's end)
+    let types = [
+        ("gyroid", "net", 0.12),
+        ("d", "net", 0.12),
+        ("p", "net", 0.26),
+        ("gyroid", "sheet", 0.1),
+        ("iwp", "sheet", 0.1),
+    ];
+    for _ in 0..3 {
+        let (ty, st, lo) = types[rng.below(types.len() as u64) as usize];
+        let axis = rng.below(3) as usize;
+        let a = rng.uniform(lo, 0.3);
+        let b = rng.uniform(lo, 0.4);
+        let cell = rng.uniform(3.0, 6.0);
+        let size = [0, 1, 2].map(|_| cell * rng.uniform(2.0, 3.6));
+        let origin = [0, 1, 2].map(|_| rng.uniform(-20.0, 20.0));
+        let r = 16 + rng.below(9) as u32;
+        let grade = format!("{}:{a}:{b}", ["x", "y", "z"][axis]);
+        let s = |v: [f64; 3]| v.map(|x| x.to_string()).join(",");
+        let (size_s, origin_s, cell_s, r_s) = (s(size), s(origin), cell.to_string(), r.to_string());
+        check_graded(
+            &[
+                "tpms",
+                "--type",
+                ty,
+                "--structure",
+                st,
+                "--density-grade",
+                &grade,
+                "--size",
+                &size_s,
+                "--cell-size",
+                &cell_s,
+                "--origin",
+                &origin_s,
+                "-r",
+                &r_s,
+            ],
+            origin,
+            [cell; 3],
+            size,
+            &|p| a + (b - a) * ((p[axis] - origin[axis]) / size[axis]).clamp(0.0, 1.0),
+        );
+    }
+}
+
+/// Bad fields: refused with one line, exit 2, no file.
+#[test]
+fn bad_fields_are_refused() {
+    let dir = tempdir();
+    let flat = dir.path().join("flat.npy");
+    let mut bytes = Vec::new();
+    latvox::io::npy::write(&mut bytes, &[4], &[0.2; 4]).unwrap();
+    std::fs::write(&flat, bytes).unwrap();
+    let flat = flat.to_str().unwrap().to_string();
+    let cases: [(&[&str], &str); 8] = [
+        (&["--density-field", "0.2 + * z"], "column 7"),
+        (&["--density-field", "0.2 + 0.1*sin(z"], "column 16"),
+        (&["--density-field", "0.2 + q"], "unknown name 'q'"),
+        (&["--density-field", &flat], "shape [4]"),
+        (
+            &["--density-field", "1.2 - z/100"],
+            "volume fractions in (0, 1)",
+        ),
+        (
+            &["--density-grade", "z:0.3:-0.1"],
+            "volume fractions in (0, 1)",
+        ),
+        (&["--type", "p", "--density-grade", "z:0.1:0.3"], "--clamp"),
+        (&["--density-grade", "w:0.1:0.3"], "AXIS:A:B"),
+    ];
+    let before = files_in(dir.path());
+    for (extra, what) in cases {
+        let mut args = vec!["tpms", "--cells", "2", "-r", "8", "-o", "x.stl"];
+        args.extend_from_slice(extra);
+        let out = run(&args, dir.path());
+        assert_refusal(dir.path(), &before, &out, &args, what);
+    }
+}
+
+/// A graded part's settings saved as a part file (its sampled field by path) make the same
+/// part again from another folder; drawing it from the part file is refused with a pointer to
+/// its mesh.
+#[test]
+fn graded_parts_are_saved_as_part_files() {
+    let dir = tempdir();
+    let data: Vec<f64> = (0..8).map(|n| 0.2 + 0.1 * (n % 2) as f64).collect();
+    let mut bytes = Vec::new();
+    latvox::io::npy::write(&mut bytes, &[2, 2, 2], &data).unwrap();
+    std::fs::write(dir.path().join("f.npy"), bytes).unwrap();
+    for (field, name) in [
+        (vec!["--density-field", "f.npy"], "a"),
+        (vec!["--density-grade", "y:0.3:0.15", "--clamp"], "b"),
+    ] {
+        let (stl, toml) = (format!("{name}.stl"), format!("{name}.toml"));
+        let mut args = vec!["tpms", "--cells", "2", "-r", "12", "-q", "-o", &stl];
+        args.extend(field);
+        args.extend(["--save-part", &toml]);
+        ok(&args, dir.path());
+        let other = tempdir();
+        let part = dir.path().join(&toml);
+        ok(
+            &[
+                "tpms",
+                "--part",
+                part.to_str().unwrap(),
+                "-q",
+                "-o",
+                "again.stl",
+            ],
+            other.path(),
+        );
+        assert_eq!(
+            std::fs::read(dir.path().join(&stl)).unwrap(),
+            std::fs::read(other.path().join("again.stl")).unwrap(),
+            "{name}"
+        );
+        let before = files_in(other.path());
+        let args = ["render", part.to_str().unwrap(), "-o", "x.png"];
+        let out = run(&args, other.path());
+        assert_refusal(other.path(), &before, &out, &args, "from its mesh");
+    }
+}
