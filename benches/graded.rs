@@ -99,7 +99,11 @@ fn main() {
                 .args(["--one", config])
                 .output()
                 .unwrap();
-            assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
             let line = String::from_utf8_lossy(&out.stdout).trim().to_string();
             last = line.split(' ').map(str::to_string).collect();
             walls.push(last[0].parse::<f64>().unwrap());

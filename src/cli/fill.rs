@@ -35,7 +35,7 @@ Examples:
   latvox fill implant.stl --no-skin --lattice gyroid --structure sheet --cell-size 3 \\
       --density 0.3 -o implant-open.stl
 
-Lattices: TPMS p, gyroid (g), d, iwp, s, frd, neovius (n), as net or sheet (--structure);
+Lattices: TPMS p, gyroid (g), d, iwp, s, frd, neovius (n), lidinoid (l), split-p, as net or sheet (--structure);
 struts sc, bcc, bccz, fcc, fccz, octet, kelvin, diamond, rhombic; or a strut cell file (.json).
 The part is read from STL, OBJ, OFF, PLY or 3MF; one that is not closed is mended with latvox's
 repair first, or refused when repair cannot close it. --density is the lattice's volume
@@ -59,7 +59,7 @@ pub struct FillArgs {
     /// No skin: the lattice cut by the part's surface (an open-cell part).
     #[arg(long, conflicts_with = "skin")]
     pub no_skin: bool,
-    /// The lattice: a TPMS (p, gyroid, d, iwp, s, frd, neovius), a strut cell (sc, bcc, bccz,
+    /// The lattice: a TPMS (p, gyroid, d, iwp, s, frd, neovius, lidinoid, split-p), a strut cell (sc, bcc, bccz,
     /// fcc, fccz, octet, kelvin, diamond, rhombic) or a strut cell file (.json).
     #[arg(long, value_name = "NAME|FILE.json", default_value = "gyroid")]
     pub lattice: String,
@@ -119,7 +119,7 @@ impl FillArgs {
             return Ok((Infilling::Strut { cell }, name.to_string()));
         }
         Err(Error::invalid(format!(
-            "unknown lattice '{name}' (known: p, gyroid, d, iwp, s, frd, neovius, {}, or a cell file .json)",
+            "unknown lattice '{name}' (known: p, gyroid, d, iwp, s, frd, neovius, lidinoid, split-p, {}, or a cell file .json)",
             BUILT_IN.join(", ")
         )))
     }

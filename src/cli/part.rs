@@ -24,6 +24,7 @@ const PART_KEYS: &[(&str, &[&str])] = &[
         &[
             "type",
             "structure",
+            "side",
             "density",
             "density-grade",
             "density-field",

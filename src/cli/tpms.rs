@@ -41,25 +41,33 @@ Examples:
   latvox tpms --type d --cells 8,8,2 --cell-size 5 \\
       --density-field '0.35 - 0.2*exp(-((x-20)^2 + (y-20)^2)/100)' -o rim.stl
 
+  # An F-RD net at 30 %: its first labyrinth falls apart there, its other one holds together
+  latvox tpms --type frd --density 0.3 --side other --cells 3 -o frd.stl
+
   # Save the part's settings as a part file; make it again, here with finer voxels
   latvox tpms --type d --density 0.25 --cells 4 -o d.stl --save-part d.toml
   latvox tpms --part d.toml --resolution 48 -o d-fine.stl
 
 Types: p (Schwarz primitive), g|gyroid, d (Schwarz diamond), iwp (Schoen I-WP),
-       s (Fischer–Koch S), frd (Schoen F-RD), n|neovius.
-Structures: net (solid on one side of F = t), sheet (solid where |F| ≤ t).
+       s (Fischer–Koch S), frd (Schoen F-RD), n|neovius, l|lidinoid, split-p (Schoen's split P).
+Structures: net (solid on one side of F = t; --side other for the other labyrinth),
+            sheet (solid where |F| ≤ t).
 The level t is found by latvox so that the written mesh has the requested volume fraction;
 the report gives the target, the fraction measured on the written mesh, and its checks
 (--verify: closed, manifold, outward and no self-intersection by default).";
 
 #[derive(Args)]
 pub struct TpmsArgs {
-    /// Surface: p, gyroid (g), d, iwp, s, frd, neovius (n).
+    /// Surface: p, gyroid (g), d, iwp, s, frd, neovius (n), lidinoid (l), split-p.
     #[arg(long = "type", short = 't', value_name = "TYPE", default_value = "gyroid", value_parser = parse_surface)]
     pub surface: Surface,
     /// Solid side: net (F ≤ t) or sheet (|F| ≤ t).
     #[arg(long, value_name = "net|sheet", default_value = "net", value_parser = parse_structure)]
     pub structure: Structure,
+    /// Which labyrinth of a net is solid: first (F ≤ t) or other (−F ≤ t, the complementary
+    /// labyrinth, for nets whose two sides differ: F-RD, I-WP, Neovius, …).
+    #[arg(long, value_name = "first|other", default_value = "first", value_parser = ["first", "other"])]
+    pub side: String,
     /// Target volume fraction of solid, in (0, 1).
     #[arg(long, short = 'd', default_value_t = 0.3, value_parser = parse_density, allow_hyphen_values = true)]
     pub density: f64,
@@ -90,7 +98,7 @@ pub struct TpmsArgs {
 
 pub(crate) fn parse_surface(s: &str) -> std::result::Result<Surface, String> {
     Surface::parse(s).ok_or_else(|| {
-        format!("unknown TPMS type '{s}' (known: p, gyroid, d, iwp, s, frd, neovius)")
+        format!("unknown TPMS type '{s}' (known: p, gyroid, d, iwp, s, frd, neovius, lidinoid, split-p)")
     })
 }
 
@@ -98,6 +106,7 @@ pub(crate) fn parse_structure(s: &str) -> std::result::Result<Structure, String>
     match s.to_ascii_lowercase().as_str() {
         "net" | "network" | "solid" => Ok(Structure::Net),
         "sheet" | "shell" => Ok(Structure::Sheet),
+        "net-other" => Ok(Structure::NetOther),
         _ => Err(format!("unknown structure '{s}' (known: net, sheet)")),
     }
 }
@@ -135,9 +144,17 @@ impl TpmsArgs {
             }
             (None, None) => None,
         };
+        let structure =
+            match (self.structure, self.side.as_str()) {
+                (Structure::Net, "other") => Structure::NetOther,
+                (Structure::Sheet, "other") => return Err(latvox::Error::invalid(
+                    "--side other picks a net's other labyrinth: a sheet is the wall between both",
+                )),
+                (st, _) => st,
+            };
         Ok(TpmsJob {
             surface: self.surface,
-            structure: self.structure,
+            structure,
             density: self.density,
             domain,
             resolution: m.resolution,

@@ -59,11 +59,13 @@ struct Table {
 }
 
 fn table(surface: Surface, structure: Structure) -> &'static Table {
-    static TABLES: [[OnceLock<Table>; 2]; 7] = [const { [const { OnceLock::new() }; 2] }; 7];
+    static TABLES: [[OnceLock<Table>; 3]; Surface::ALL.len()] =
+        [const { [const { OnceLock::new() }; 3] }; Surface::ALL.len()];
     let si = Surface::ALL.iter().position(|s| *s == surface).unwrap();
     let ki = match structure {
         Structure::Net => 0,
         Structure::Sheet => 1,
+        Structure::NetOther => 2,
     };
     TABLES[si][ki].get_or_init(|| Table::new(surface, structure))
 }
@@ -78,6 +80,7 @@ impl Table {
             let v = match structure {
                 Structure::Net => f,
                 Structure::Sheet => f.abs(),
+                Structure::NetOther => -f,
             };
             (
                 v as f32,
@@ -163,7 +166,7 @@ impl Table {
             whole + partial
         };
         let count = match self.structure {
-            Structure::Net => below(t),
+            Structure::Net | Structure::NetOther => below(t),
             // |F| ≤ t is F ≤ t less F < −t; the spread is symmetric, so |F| serves for F.
             Structure::Sheet => below(t) - if t < w { below(-t) } else { 0.0 },
         };
@@ -266,6 +269,10 @@ pub fn connectivity_sampled(
         Structure::Net => Connectivity {
             solid: one(&|f| f <= t),
             void: one(&|f| f > t),
+        },
+        Structure::NetOther => Connectivity {
+            solid: one(&|f| -f <= t),
+            void: one(&|f| -f > t),
         },
         Structure::Sheet => Connectivity {
             solid: t > 0.0 && one(&|f| f.abs() <= t),
@@ -441,7 +448,7 @@ const ACCEPT: f64 = 0.02;
 fn half_cell_axis(surface: Surface, structure: Structure, cell: Vec3, voxel: f64) -> Option<usize> {
     let symmetric = matches!(
         (structure, surface.is_even()),
-        (Structure::Sheet, Some(_)) | (Structure::Net, Some(true))
+        (Structure::Sheet, Some(_)) | (Structure::Net | Structure::NetOther, Some(true))
     );
     let whole = (0..3).all(|a| {
         let n = cell[a] / voxel;
@@ -559,7 +566,7 @@ pub fn calibrate(
 /// two net minima near 0.1 refined at 128). Sheet minima are 0: a wall around the connected
 /// surface `F = 0` cannot fall apart however thin (the sampled test loses walls thinner than a
 /// sample spacing). `(surface, structure, solid range, void range)`; a test recomputes them.
-pub const PERCOLATION: [(Surface, Structure, FeasibleRange, FeasibleRange); 14] = {
+pub const PERCOLATION: [(Surface, Structure, FeasibleRange, FeasibleRange); 18] = {
     const fn r(min: f64, max: f64) -> FeasibleRange {
         FeasibleRange { min, max }
     }
@@ -580,11 +587,33 @@ pub const PERCOLATION: [(Surface, Structure, FeasibleRange, FeasibleRange); 14] 
         (Frd, Sheet, r(0.0, 0.4409), r(0.0, 0.4259)),
         (Neovius, Net, r(0.3388, 1.0), r(0.0, 0.66)),
         (Neovius, Sheet, r(0.0, 1.0), r(0.0, 0.3245)),
+        // Their sheets sampled at 64 seem to fall apart below 0.22 and 0.13: walls thinner than a
+        // sample; at 128 and 192 samples they hold at 0.15 and 0.08.
+        (Lidinoid, Net, r(0.2544, 1.0), r(0.0, 0.5035)),
+        (Lidinoid, Sheet, r(0.0, 1.0), r(0.0, 0.2305)),
+        (SplitP, Net, r(0.1434, 1.0), r(0.0, 0.7222)),
+        (SplitP, Sheet, r(0.0, 1.0), r(0.0, 0.4325)),
     ]
 };
 
+/// The net's other labyrinth at density `ρ` is the net's void at `1 − ρ`, and its void the
+/// net's solid: its ranges from the net's, `(solid, void)`.
+fn other_side(surface: Surface) -> (FeasibleRange, FeasibleRange) {
+    let flip = |r: FeasibleRange| FeasibleRange {
+        min: 1.0 - r.max,
+        max: 1.0 - r.min,
+    };
+    (
+        flip(void_connected_range(surface, Structure::Net)),
+        flip(feasible(surface, Structure::Net)),
+    )
+}
+
 /// The feasible range (solid in one piece) of a surface and structure.
 pub fn feasible(surface: Surface, structure: Structure) -> FeasibleRange {
+    if structure == Structure::NetOther {
+        return other_side(surface).0;
+    }
     PERCOLATION
         .iter()
         .find(|e| e.0 == surface && e.1 == structure)
@@ -594,6 +623,9 @@ pub fn feasible(surface: Surface, structure: Structure) -> FeasibleRange {
 
 /// Where the void percolates (no closed voids).
 pub fn void_connected_range(surface: Surface, structure: Structure) -> FeasibleRange {
+    if structure == Structure::NetOther {
+        return other_side(surface).1;
+    }
     PERCOLATION
         .iter()
         .find(|e| e.0 == surface && e.1 == structure)

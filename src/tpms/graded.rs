@@ -340,6 +340,7 @@ impl Field for GradedField<'_> {
         let sign = match self.tpms.structure {
             Structure::Net => 1.0,
             Structure::Sheet => f.signum(),
+            Structure::NetOther => -1.0,
         };
         (
             self.tpms.implicit_at(f, t),

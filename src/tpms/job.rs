@@ -257,8 +257,23 @@ impl TpmsJob {
             void: self.density >= voids.min && self.density <= voids.max,
         };
         if !conn.solid && !self.allow_islands {
+            // A net's other labyrinth may hold together where this one does not.
+            let other = match st {
+                Structure::Net => Some((Structure::NetOther, "--side other")),
+                Structure::NetOther => Some((Structure::Net, "--side first")),
+                Structure::Sheet => None,
+            };
+            let hint = other
+                .map(|(o, flag)| (calibrate::feasible(s, o), flag))
+                .filter(|(r, _)| self.density >= r.min && self.density <= r.max)
+                .map_or(String::new(), |(r, flag)| {
+                    format!(
+                        "; the other labyrinth holds together from {:.3} to {:.3} ({flag})",
+                        r.min, r.max
+                    )
+                });
             return Err(Error::invalid(format!(
-                "density {} is outside the feasible range of a {} {} ({:.3} to {:.3}): the solid falls apart into islands (--allow-islands builds it anyway)",
+                "density {} is outside the feasible range of a {} {} ({:.3} to {:.3}): the solid falls apart into islands (--allow-islands builds it anyway){hint}",
                 self.density,
                 s.name(),
                 st.name(),

@@ -30,6 +30,10 @@ pub enum Surface {
     Frd,
     /// Neovius.
     Neovius,
+    /// Lidinoid (Lidin and Larsson's approximation).
+    Lidinoid,
+    /// Schoen's split P (the nodal approximation).
+    SplitP,
 }
 
 /// Which side of the surface is solid.
@@ -40,6 +44,11 @@ pub enum Structure {
     Net,
     /// Solid where `|F| ≤ t`: a wall of thickness set by `t` around the surface.
     Sheet,
+    /// The net's other labyrinth: solid where `−F ≤ t` (`--side other`). Where the two sides of
+    /// the surface differ (F-RD, I-WP, Neovius, …) it holds together at densities where the
+    /// net does not.
+    #[serde(rename = "net-other")]
+    NetOther,
 }
 
 impl Structure {
@@ -48,13 +57,14 @@ impl Structure {
         match self {
             Structure::Net => "net",
             Structure::Sheet => "sheet",
+            Structure::NetOther => "net-other",
         }
     }
 }
 
 impl Surface {
     /// Every surface.
-    pub const ALL: [Surface; 7] = [
+    pub const ALL: [Surface; 9] = [
         Surface::P,
         Surface::Gyroid,
         Surface::D,
@@ -62,6 +72,8 @@ impl Surface {
         Surface::S,
         Surface::Frd,
         Surface::Neovius,
+        Surface::Lidinoid,
+        Surface::SplitP,
     ];
 
     /// The surface's name on the command line and in reports (`p`, `gyroid`, …).
@@ -74,6 +86,8 @@ impl Surface {
             Surface::S => "s",
             Surface::Frd => "frd",
             Surface::Neovius => "neovius",
+            Surface::Lidinoid => "lidinoid",
+            Surface::SplitP => "split-p",
         }
     }
 
@@ -87,6 +101,8 @@ impl Surface {
             "s" | "fischer-koch-s" | "fks" => Surface::S,
             "f" | "frd" | "f-rd" => Surface::Frd,
             "n" | "neovius" => Surface::Neovius,
+            "l" | "lidinoid" => Surface::Lidinoid,
+            "split-p" | "splitp" | "split_p" => Surface::SplitP,
             _ => return None,
         })
     }
@@ -151,6 +167,28 @@ impl Surface {
             t(3.0, [(0, O), (0, O), (1, C)]),
             t(4.0, [(1, C), (1, C), (1, C)]),
         ];
+        // ½(sin 2X cos Y sin Z + …) − ½(cos 2X cos 2Y + …) + 0.15.
+        const L: &[Term] = &[
+            t(0.5, [(2, S), (1, C), (1, S)]),
+            t(0.5, [(1, S), (2, S), (1, C)]),
+            t(0.5, [(1, C), (1, S), (2, S)]),
+            t(-0.5, [(2, C), (2, C), (0, O)]),
+            t(-0.5, [(0, O), (2, C), (2, C)]),
+            t(-0.5, [(2, C), (0, O), (2, C)]),
+            t(0.15, [(0, O), (0, O), (0, O)]),
+        ];
+        // 1.1(sin 2X sin Z cos Y + …) − 0.2(cos 2X cos 2Y + …) − 0.4(cos 2X + …).
+        const SP: &[Term] = &[
+            t(1.1, [(2, S), (1, C), (1, S)]),
+            t(1.1, [(1, S), (2, S), (1, C)]),
+            t(1.1, [(1, C), (1, S), (2, S)]),
+            t(-0.2, [(2, C), (2, C), (0, O)]),
+            t(-0.2, [(0, O), (2, C), (2, C)]),
+            t(-0.2, [(2, C), (0, O), (2, C)]),
+            t(-0.4, [(2, C), (0, O), (0, O)]),
+            t(-0.4, [(0, O), (2, C), (0, O)]),
+            t(-0.4, [(0, O), (0, O), (2, C)]),
+        ];
         match self {
             Surface::P => P,
             Surface::Gyroid => G,
@@ -159,6 +197,8 @@ impl Surface {
             Surface::S => FKS,
             Surface::Frd => FRD,
             Surface::Neovius => N,
+            Surface::Lidinoid => L,
+            Surface::SplitP => SP,
         }
     }
 
@@ -401,6 +441,7 @@ impl TpmsField {
         match self.structure {
             Structure::Net => f - t,
             Structure::Sheet => f.abs() - t,
+            Structure::NetOther => -f - t,
         }
     }
 
@@ -508,6 +549,7 @@ impl Field for TpmsField {
         let sign = match self.structure {
             Structure::Net => 1.0,
             Structure::Sheet => f.signum(),
+            Structure::NetOther => -1.0,
         };
         (
             self.implicit(f),
@@ -549,6 +591,26 @@ mod tests {
                     - (c(2.0 * x) * c(2.0 * y) + c(2.0 * y) * c(2.0 * z) + c(2.0 * z) * c(2.0 * x)))
             }
             Surface::Neovius => 3.0 * (c(x) + c(y) + c(z)) + 4.0 * c(x) * c(y) * c(z),
+            Surface::Lidinoid => {
+                0.5 * (sn(2.0 * x) * c(y) * sn(z)
+                    + sn(2.0 * y) * c(z) * sn(x)
+                    + sn(2.0 * z) * c(x) * sn(y))
+                    - 0.5
+                        * (c(2.0 * x) * c(2.0 * y)
+                            + c(2.0 * y) * c(2.0 * z)
+                            + c(2.0 * z) * c(2.0 * x))
+                    + 0.15
+            }
+            Surface::SplitP => {
+                1.1 * (sn(2.0 * x) * sn(z) * c(y)
+                    + sn(2.0 * y) * sn(x) * c(z)
+                    + sn(2.0 * z) * sn(y) * c(x))
+                    - 0.2
+                        * (c(2.0 * x) * c(2.0 * y)
+                            + c(2.0 * y) * c(2.0 * z)
+                            + c(2.0 * z) * c(2.0 * x))
+                    - 0.4 * (c(2.0 * x) + c(2.0 * y) + c(2.0 * z))
+            }
         }
     }
 
@@ -612,6 +674,14 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    #[test]
+    fn every_surface_fits_the_editor_shader() {
+        // trace.glsl holds 10 terms (uTerms[10]).
+        for s in Surface::ALL {
+            assert!(s.terms().len() <= 10, "{s:?}");
         }
     }
 

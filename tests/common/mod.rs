@@ -201,6 +201,17 @@ pub fn tpms(name: &str, p: [f64; 3], a: f64) -> (f64, [f64; 3]) {
                     - (c(2. * x) * c(2. * y) + c(2. * y) * c(2. * z) + c(2. * z) * c(2. * x)))
             }
             "neovius" => 3.0 * (c(x) + c(y) + c(z)) + 4.0 * c(x) * c(y) * c(z),
+            // Lidin and Larsson (2002); Schoen's split P as tabulated by Wohlgemuth et al. (2001).
+            "lidinoid" => {
+                0.5 * (s(2. * x) * c(y) * s(z) + s(2. * y) * c(z) * s(x) + s(2. * z) * c(x) * s(y))
+                    - 0.5 * (c(2. * x) * c(2. * y) + c(2. * y) * c(2. * z) + c(2. * z) * c(2. * x))
+                    + 0.15
+            }
+            "split-p" => {
+                1.1 * (s(2. * x) * s(z) * c(y) + s(2. * y) * s(x) * c(z) + s(2. * z) * s(y) * c(x))
+                    - 0.2 * (c(2. * x) * c(2. * y) + c(2. * y) * c(2. * z) + c(2. * z) * c(2. * x))
+                    - 0.4 * (c(2. * x) + c(2. * y) + c(2. * z))
+            }
             _ => panic!("unknown {name}"),
         }
     };

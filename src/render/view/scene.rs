@@ -195,7 +195,13 @@ impl Scene {
                     .into_iter()
                     .map(|(coef, f)| {
                         let [x, y, z] = f.map(|(k, t)| 3.0 * k as f64 + t as f64);
-                        [coef, x, y, z]
+                        // The other labyrinth is the net of −F.
+                        let sign = if l.structure == Structure::NetOther {
+                            -1.0
+                        } else {
+                            1.0
+                        };
+                        [sign * coef, x, y, z]
                     })
                     .collect();
                 scene.tpms = Some(Tpms {

@@ -31,7 +31,7 @@ uniform vec3 uCell;         // cell size, mm
 uniform vec3 uPhase;        // a cell's lower corner, mm
 // TPMS
 uniform int uTermCount;
-uniform vec4 uTerms[8];     // coef, 3k + f per axis (f: 0 one, 1 cos, 2 sin)
+uniform vec4 uTerms[10];    // coef, 3k + f per axis (f: 0 one, 1 cos, 2 sin)
 uniform int uSheet;
 uniform float uLipschitz;
 // Struts, listed per bin of the cell: two texels per strut, (a, factor) and (b, factor), 1024
@@ -86,7 +86,7 @@ vec2 tpms(vec3 p) {
     vec3 u = (p - uPhase) / uCell;
     float F = 0.0;
     vec3 g = vec3(0.0);
-    for (int i = 0; i < 8; i++) {
+    for (int i = 0; i < 10; i++) {
         if (i >= uTermCount) break;
         vec4 t = uTerms[i];
         vec2 fx = factor(t.y, u.x);

@@ -180,7 +180,7 @@ function loadScene(scene) {
   set('uAoReach', '1f', scene.cell / 6);
   if (scene.kind === 'tpms') {
     const t = scene.tpms;
-    const terms = new Float32Array(32);
+    const terms = new Float32Array(40);
     t.terms.forEach((row, i) => terms.set(row, 4 * i));
     set('uKind', '1i', 0);
     set('uTerms', '4fv', terms);
