@@ -15,8 +15,8 @@
 
 use latvox::field::density::DensityField;
 use latvox::field::Domain;
+use latvox::mesh::graded::Grading;
 use latvox::progress::Progress;
-use latvox::tpms::graded::Grading;
 use latvox::tpms::{Structure, Surface, TpmsJob};
 use std::sync::Arc;
 use std::time::Instant;

@@ -23,6 +23,7 @@ use support::{peak_rss_mb, DiscardedStl};
 fn scale(n: u32) {
     let t = Instant::now();
     let job = StrutJob {
+        grading: None,
         cell: Arc::new(UnitCell::built_in("bcc").unwrap()),
         cell_name: "bcc".into(),
         sizing: Sizing::Radius(0.35),
@@ -65,6 +66,7 @@ fn main() {
         }
         let t = Instant::now();
         let job = StrutJob {
+            grading: None,
             cell: Arc::new(UnitCell::built_in(name).unwrap()),
             cell_name: name.to_string(),
             sizing: Sizing::Density(0.2),

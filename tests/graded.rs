@@ -1,4 +1,4 @@
-//! Graded TPMS lattices (`latvox tpms --density-grade / --density-field`), run as a user runs
+//! Graded lattices (`latvox tpms|strut --density-grade / --density-field`), run as a user runs
 //! them: every whole cell's density measured by manifold3d on the written mesh (cut at the
 //! cells' faces; `checkers/cell_density.py`) against the field at the cell's centre, computed
 //! here from the field's own formula; the part closed and in one piece by manifold3d and by
@@ -134,6 +134,99 @@ fn a_gyroid_graded_along_z_meets_the_grade_in_every_cell() {
     );
     // The grade is met far inside the promise.
     assert!(worst < 0.005, "{worst}");
+}
+
+/// The must-show strut part: a 6×6×6-cell BCC block graded 0.1 → 0.4 along z (the strut
+/// radius varies with the height).
+#[test]
+fn a_bcc_block_graded_along_z_meets_the_grade_in_every_cell() {
+    let worst = check_graded(
+        &[
+            "strut",
+            "--cell",
+            "bcc",
+            "--density-grade",
+            "z:0.1:0.4",
+            "--cells",
+            "6",
+            "--cell-size",
+            "5",
+            "-r",
+            "24",
+        ],
+        [0.0; 3],
+        [5.0; 3],
+        [30.0; 3],
+        &|p| 0.1 + 0.3 * p[2] / 30.0,
+    );
+    assert!(worst < 0.005, "{worst}");
+}
+
+/// Strut cells graded at random (seeded): cell, axis, the grade's ends, a box that may end
+/// inside a cell, an origin, a resolution; and an octet truss graded by an expression, its
+/// joints blended.
+#[test]
+fn strut_lattices_are_graded_for_every_setting() {
+    let mut rng = Rng(0x57_2a7);
+    for _ in 0..2 {
+        let name = ["bcc", "octet", "kelvin", "fccz"][rng.below(4) as usize];
+        let axis = rng.below(3) as usize;
+        let a = rng.uniform(0.08, 0.3);
+        let b = rng.uniform(0.08, 0.3);
+        let cell = rng.uniform(3.0, 6.0);
+        let size = [0, 1, 2].map(|_| cell * rng.uniform(2.0, 3.4));
+        let origin = [0, 1, 2].map(|_| rng.uniform(-20.0, 20.0));
+        let r = 16 + rng.below(9) as u32;
+        let grade = format!("{}:{a}:{b}", ["x", "y", "z"][axis]);
+        let s = |v: [f64; 3]| v.map(|x| x.to_string()).join(",");
+        let (size_s, origin_s, cell_s, r_s) = (s(size), s(origin), cell.to_string(), r.to_string());
+        check_graded(
+            &[
+                "strut",
+                "--cell",
+                name,
+                "--density-grade",
+                &grade,
+                "--size",
+                &size_s,
+                "--cell-size",
+                &cell_s,
+                "--origin",
+                &origin_s,
+                "-r",
+                &r_s,
+            ],
+            origin,
+            [cell; 3],
+            size,
+            &|p| a + (b - a) * ((p[axis] - origin[axis]) / size[axis]).clamp(0.0, 1.0),
+        );
+    }
+    check_graded(
+        &[
+            "strut",
+            "--cell",
+            "octet",
+            "--blend",
+            "0.3",
+            "--density-field",
+            "0.15 + 0.08*cos(PI*x/12)*sin(PI*z/12)",
+            "--cells",
+            "4,3,3",
+            "--cell-size",
+            "6",
+            "-r",
+            "20",
+        ],
+        [0.0; 3],
+        [6.0; 3],
+        [24.0, 18.0, 18.0],
+        &|p| {
+            0.15 + 0.08
+                * (std::f64::consts::PI * p[0] / 12.0).cos()
+                * (std::f64::consts::PI * p[2] / 12.0).sin()
+        },
+    );
 }
 
 /// An expression whose field bends within cells, where a piece the box cuts loose (and that is
@@ -308,6 +401,35 @@ fn bad_fields_are_refused() {
     }
 }
 
+/// Bad strut gradings: a density or radius beside the field, beams, a grade where the pores
+/// close: refused with one line, exit 2, no file.
+#[test]
+fn bad_strut_gradings_are_refused() {
+    let dir = tempdir();
+    let cases: [(&[&str], &str); 5] = [
+        (&["--density", "0.2"], "cannot be used with"),
+        (&["--radius", "0.4"], "cannot be used with"),
+        (&["--beams"], "drop --beams"),
+        (&["--density-grade", "z:0.2:0.99"], "--clamp"),
+        (&["--density-field", "0.2 + d/100"], "only latvox fill"),
+    ];
+    let before = files_in(dir.path());
+    for (extra, what) in cases {
+        let out = if extra.contains(&"--beams") {
+            "x.3mf"
+        } else {
+            "x.stl"
+        };
+        let mut args = vec!["strut", "--cells", "2", "-r", "12", "-o", out];
+        if !extra.contains(&"--density-grade") && !extra.contains(&"--density-field") {
+            args.extend(["--density-grade", "z:0.1:0.3"]);
+        }
+        args.extend_from_slice(extra);
+        let out = run(&args, dir.path());
+        assert_refusal(dir.path(), &before, &out, &args, what);
+    }
+}
+
 /// A graded part's settings saved as a part file (its sampled field by path) make the same
 /// part again from another folder; drawing it from the part file is refused with a pointer to
 /// its mesh.
@@ -318,12 +440,17 @@ fn graded_parts_are_saved_as_part_files() {
     let mut bytes = Vec::new();
     latvox::io::npy::write(&mut bytes, &[2, 2, 2], &data).unwrap();
     std::fs::write(dir.path().join("f.npy"), bytes).unwrap();
-    for (field, name) in [
-        (vec!["--density-field", "f.npy"], "a"),
-        (vec!["--density-grade", "y:0.3:0.15", "--clamp"], "b"),
+    for (command, field, name) in [
+        ("tpms", vec!["--density-field", "f.npy"], "a"),
+        (
+            "tpms",
+            vec!["--density-grade", "y:0.3:0.15", "--clamp"],
+            "b",
+        ),
+        ("strut", vec!["--density-grade", "x:0.1:0.25"], "c"),
     ] {
         let (stl, toml) = (format!("{name}.stl"), format!("{name}.toml"));
-        let mut args = vec!["tpms", "--cells", "2", "-r", "12", "-q", "-o", &stl];
+        let mut args = vec![command, "--cells", "2", "-r", "12", "-q", "-o", &stl];
         args.extend(field);
         args.extend(["--save-part", &toml]);
         ok(&args, dir.path());
@@ -331,7 +458,7 @@ fn graded_parts_are_saved_as_part_files() {
         let part = dir.path().join(&toml);
         ok(
             &[
-                "tpms",
+                command,
                 "--part",
                 part.to_str().unwrap(),
                 "-q",

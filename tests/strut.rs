@@ -37,6 +37,7 @@ fn every_built_in_cell_meets_its_density_closed_and_in_one_piece() {
     for name in latvox::strut::cell::BUILT_IN {
         for target in [0.1, 0.2, 0.3] {
             let job = StrutJob {
+                grading: None,
                 cell: Arc::new(UnitCell::built_in(name).unwrap()),
                 cell_name: name.to_string(),
                 sizing: Sizing::Density(target),

@@ -8,12 +8,68 @@ use super::{
 };
 use clap::Args;
 use latvox::check::verify::Verify;
+use latvox::field::density::DensityField;
 use latvox::field::Domain;
 use latvox::io::sink::{MeshFile, MeshSink};
+use latvox::mesh::graded::{Grading, GradingReport};
 use latvox::mesh::pipeline::Options;
 use latvox::mesh::report::PartReport;
 use latvox::{Error, Result};
 use std::path::PathBuf;
+
+/// A density that varies through the part.
+#[derive(Args, Clone)]
+pub struct GradeArgs {
+    /// Grade the density linearly along an axis across the box: AXIS:A:B (as z:0.1:0.4); every
+    /// whole cell meets the grade at its centre within ±0.01.
+    #[arg(long, value_name = "AXIS:A:B", conflicts_with = "density_field")]
+    pub density_grade: Option<String>,
+    /// Grade the density by a field: an expression in x, y, z (mm; as "0.15 + 0.1*sin(PI*x/20)")
+    /// or a .npy array of shape (NX, NY, NZ) sampled over the box, corners on its corners.
+    #[arg(long, value_name = "EXPR|FILE.npy", allow_hyphen_values = true)]
+    pub density_field: Option<String>,
+    /// Hold a density field to the type's feasible range instead of refusing it (reported).
+    #[arg(long)]
+    pub clamp: bool,
+}
+
+impl GradeArgs {
+    /// The grading asked for over `bounds`, if any.
+    pub fn grading(&self, bounds: &latvox::field::Aabb) -> Result<Option<Grading>> {
+        let field = match (&self.density_grade, &self.density_field) {
+            (Some(g), _) => DensityField::grade(g, bounds)?,
+            (None, Some(f)) => DensityField::parse(f, bounds)?,
+            (None, None) if self.clamp => {
+                return Err(Error::invalid(
+                    "--clamp holds a density field (--density-grade or --density-field) to the feasible range: give one",
+                ))
+            }
+            (None, None) => return Ok(None),
+        };
+        Ok(Some(Grading {
+            field: std::sync::Arc::new(field),
+            clamp: self.clamp,
+        }))
+    }
+}
+
+/// The density line of a graded part's summary.
+pub fn print_grading(g: &GradingReport, p: &PartReport) {
+    outln!(
+        "density   {} ({:.3} to {:.3}) · {} whole cells {} (largest error {:.4}) · part {:.4}",
+        g.field,
+        g.range[0],
+        g.range[1],
+        g.whole_cells,
+        if g.cells_met {
+            "within their promise"
+        } else {
+            "NOT all within their promise"
+        },
+        g.max_cell_error,
+        p.achieved_density
+    );
+}
 
 /// The box: two of cells, cell size and overall size, and the lower corner.
 #[derive(Args, Clone)]

@@ -32,7 +32,18 @@ const PART_KEYS: &[(&str, &[&str])] = &[
             "allow-islands",
         ],
     ),
-    ("strut", &["cell", "density", "radius", "blend"]),
+    (
+        "strut",
+        &[
+            "cell",
+            "density",
+            "radius",
+            "density-grade",
+            "density-field",
+            "clamp",
+            "blend",
+        ],
+    ),
     (
         "fill",
         &[
@@ -113,7 +124,14 @@ const COMMON: &[&str] = &[
 
 /// Options that exclude each other: giving one on the command line drops the other from the
 /// file.
-const EXCLUSIVE: &[[&str; 2]] = &[["density", "radius"]];
+const EXCLUSIVE: &[[&str; 2]] = &[
+    ["density", "radius"],
+    ["density", "density-grade"],
+    ["density", "density-field"],
+    ["radius", "density-grade"],
+    ["radius", "density-field"],
+    ["density-grade", "density-field"],
+];
 
 /// The short forms of long options, to tell whether the command line gave one.
 const SHORT: &[(&str, &str)] = &[("type", "-t"), ("density", "-d"), ("resolution", "-r")];
@@ -142,11 +160,33 @@ pub fn save(
     table.insert("command".into(), toml::Value::String(command.into()));
     for key in keys(command) {
         // The option, or an argument of that name (`fill`'s PART, also given as `--input`).
-        let raw = cmd
-            .get_arguments()
-            .filter(|a| a.get_long() == Some(key) || a.get_id().as_str() == key)
-            .find_map(|a| matches.try_get_raw(a.get_id().as_str()).ok().flatten());
-        let Some(raw) = raw else { continue };
+        let ids = |key: &str| -> Vec<String> {
+            cmd.get_arguments()
+                .filter(|a| a.get_long() == Some(key) || a.get_id().as_str() == key)
+                .map(|a| a.get_id().as_str().to_string())
+                .collect()
+        };
+        let given = |key: &str| {
+            ids(key).iter().any(|i| {
+                matches!(
+                    matches.value_source(i),
+                    Some(s) if s != clap::parser::ValueSource::DefaultValue
+                )
+            })
+        };
+        // A default that an exclusive option given replaces (a density beside a graded one).
+        let replaced = !given(key)
+            && EXCLUSIVE
+                .iter()
+                .filter(|pair| pair.contains(&key))
+                .flat_map(|pair| pair.iter())
+                .any(|k| *k != key && given(k));
+        let raw = ids(key)
+            .into_iter()
+            .find_map(|i| matches.try_get_raw(&i).ok().flatten());
+        let Some(raw) = raw.filter(|_| !replaced) else {
+            continue;
+        };
         let mut raw: Vec<String> = raw.map(|v| v.to_string_lossy().into_owned()).collect();
         let full = |v: &str| -> Result<String> {
             let p = Path::new(v);

@@ -1,11 +1,11 @@
 //! `latvox tpms`: a closed TPMS lattice at an exact volume fraction.
 
-use super::lattice::{human, print_part, triple, BoxArgs, MeshArgs, PartArgs};
+use super::lattice::{
+    human, print_grading, print_part, triple, BoxArgs, GradeArgs, MeshArgs, PartArgs,
+};
 use super::out::outln;
 use super::parse_density;
 use clap::Args;
-use latvox::field::density::DensityField;
-use latvox::tpms::graded::Grading;
 use latvox::tpms::{Structure, Surface, TpmsJob, TpmsReport};
 use latvox::Result;
 
@@ -69,19 +69,11 @@ pub struct TpmsArgs {
     #[arg(long, value_name = "first|other", default_value = "first", value_parser = ["first", "other"])]
     pub side: String,
     /// Target volume fraction of solid, in (0, 1).
-    #[arg(long, short = 'd', default_value_t = 0.3, value_parser = parse_density, allow_hyphen_values = true)]
+    #[arg(long, short = 'd', default_value_t = 0.3, value_parser = parse_density, allow_hyphen_values = true, conflicts_with_all = ["density_grade", "density_field"])]
     pub density: f64,
-    /// Grade the density linearly along an axis across the box: AXIS:A:B (as z:0.1:0.4); every
-    /// whole cell meets the grade at its centre within ±0.01.
-    #[arg(long, value_name = "AXIS:A:B", conflicts_with = "density_field")]
-    pub density_grade: Option<String>,
-    /// Grade the density by a field: an expression in x, y, z (mm; as "0.15 + 0.1*sin(PI*x/20)")
-    /// or a .npy array of shape (NX, NY, NZ) sampled over the box, corners on its corners.
-    #[arg(long, value_name = "EXPR|FILE.npy", allow_hyphen_values = true)]
-    pub density_field: Option<String>,
-    /// Hold a density field to the type's feasible range instead of refusing it (reported).
-    #[arg(long)]
-    pub clamp: bool,
+    /// A density that varies through the part.
+    #[command(flatten)]
+    pub grade: GradeArgs,
     /// The box of cells.
     #[command(flatten)]
     pub domain: BoxArgs,
@@ -134,16 +126,7 @@ impl TpmsArgs {
         let o = m.options();
         let domain = self.domain.domain()?;
         let bounds = domain.bounds();
-        let field = match (&self.density_grade, &self.density_field) {
-            (Some(g), _) => Some(DensityField::grade(g, &bounds)?),
-            (None, Some(f)) => Some(DensityField::parse(f, &bounds)?),
-            (None, None) if self.clamp => {
-                return Err(latvox::Error::invalid(
-                    "--clamp holds a density field (--density-grade or --density-field) to the feasible range: give one",
-                ))
-            }
-            (None, None) => None,
-        };
+        let grading = self.grade.grading(&bounds)?;
         let structure =
             match (self.structure, self.side.as_str()) {
                 (Structure::Net, "other") => Structure::NetOther,
@@ -166,10 +149,7 @@ impl TpmsArgs {
             tile: o.tile,
             memory: o.memory,
             keep_fragments: o.keep_fragments,
-            grading: field.map(|f| Grading {
-                field: std::sync::Arc::new(f),
-                clamp: self.clamp,
-            }),
+            grading,
         })
     }
 }
@@ -186,20 +166,7 @@ fn print_tpms_summary(r: &TpmsReport) {
     );
     let p = &r.part;
     if let Some(g) = &r.grading {
-        outln!(
-            "density   {} ({:.3} to {:.3}) · {} whole cells {} (largest error {:.4}) · part {:.4}",
-            g.field,
-            g.range[0],
-            g.range[1],
-            g.whole_cells,
-            if g.cells_met {
-                "within their promise"
-            } else {
-                "NOT all within their promise"
-            },
-            g.max_cell_error,
-            p.achieved_density
-        );
+        print_grading(g, p);
         print_part(p);
         return;
     }

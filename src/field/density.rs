@@ -7,6 +7,7 @@
 //! that are not variables, constants or functions, and hands `exmex` the expression fully
 //! parenthesised (so `-x^2` is `-(x²)`, as in mathematics, and `2^3^2` is `2^(3^2)`).
 
+use super::nodes::Nodes;
 use super::{Aabb, Vec3};
 use crate::error::{Error, Result};
 use exmex::Express;
@@ -47,11 +48,7 @@ enum Kind {
         vars: Vec<usize>,
     },
     /// Samples at the nodes of a regular grid whose corners are the box's corners.
-    Samples {
-        shape: [usize; 3],
-        data: Vec<f64>,
-        bounds: Aabb,
-    },
+    Samples(Nodes),
 }
 
 impl DensityField {
@@ -127,12 +124,15 @@ impl DensityField {
                 a.shape
             )));
         }
+        let n = [a.shape[0], a.shape[1], a.shape[2]];
+        let size = bounds.size();
         Ok(DensityField {
-            kind: Kind::Samples {
-                shape: [a.shape[0], a.shape[1], a.shape[2]],
-                data: a.data,
-                bounds: *bounds,
-            },
+            kind: Kind::Samples(Nodes {
+                origin: bounds.min,
+                step: [0, 1, 2].map(|i| size[i] / (n[i] - 1) as f64),
+                n,
+                values: a.data,
+            }),
             source: format!("samples {}", path.display()),
         })
     }
@@ -154,29 +154,7 @@ impl DensityField {
                 let args: Vec<f64> = vars.iter().map(|&i| all[i]).collect();
                 expr.eval(&args).unwrap_or(f64::NAN)
             }
-            Kind::Samples {
-                shape,
-                data,
-                bounds,
-            } => {
-                let size = bounds.size();
-                let mut i0 = [0usize; 3];
-                let mut w = [0.0; 3];
-                for a in 0..3 {
-                    let u =
-                        ((p[a] - bounds.min[a]) / size[a]).clamp(0.0, 1.0) * (shape[a] - 1) as f64;
-                    i0[a] = (u.floor() as usize).min(shape[a] - 2);
-                    w[a] = u - i0[a] as f64;
-                }
-                let at = |i: usize, j: usize, k: usize| data[(i * shape[1] + j) * shape[2] + k];
-                let mut v = 0.0;
-                for c in 0..8 {
-                    let (di, dj, dk) = (c >> 2 & 1, c >> 1 & 1, c & 1);
-                    let f = |d: usize, a: usize| if d == 1 { w[a] } else { 1.0 - w[a] };
-                    v += f(di, 0) * f(dj, 1) * f(dk, 2) * at(i0[0] + di, i0[1] + dj, i0[2] + dk);
-                }
-                v
-            }
+            Kind::Samples(nodes) => nodes.at(p),
         }
     }
 }

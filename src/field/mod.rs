@@ -8,6 +8,7 @@
 
 pub mod density;
 pub mod domain;
+pub mod nodes;
 pub mod periodic;
 
 pub use domain::Domain;
@@ -146,6 +147,11 @@ impl Aabb {
     pub fn volume(&self) -> f64 {
         let s = self.size();
         s[0] * s[1] * s[2]
+    }
+
+    /// The centre, mm.
+    pub fn centre(&self) -> Vec3 {
+        [0, 1, 2].map(|a| 0.5 * (self.min[a] + self.max[a]))
     }
 
     /// Whether `p` lies in the box (faces included).

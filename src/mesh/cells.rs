@@ -155,10 +155,15 @@ impl CellVolumes {
             .collect()
     }
 
-    /// The per-cell volumes of an in-memory mesh, its triangles taken in parallel.
-    pub fn of_mesh(mesh: &super::Mesh, bounds: Aabb, cell: Vec3) -> CellVolumes {
+    /// The cell size, mm.
+    pub fn cell(&self) -> Vec3 {
+        self.cell
+    }
+
+    /// Adds the triangles of an in-memory mesh, in parallel.
+    pub fn add_mesh(&mut self, mesh: &super::Mesh) {
         use rayon::prelude::*;
-        let empty = CellVolumes::new(bounds, cell);
+        let empty = CellVolumes::new(self.bounds, self.cell);
         const CHUNK: usize = 1 << 15;
         let parts: Vec<CellVolumes> = (0..mesh.triangle_count().div_ceil(CHUNK))
             .into_par_iter()
@@ -170,10 +175,16 @@ impl CellVolumes {
                 v
             })
             .collect();
-        parts.iter().fold(empty, |mut acc, p| {
-            acc.merge(p);
-            acc
-        })
+        for p in &parts {
+            self.merge(p);
+        }
+    }
+
+    /// The per-cell volumes of an in-memory mesh.
+    pub fn of_mesh(mesh: &super::Mesh, bounds: Aabb, cell: Vec3) -> CellVolumes {
+        let mut v = CellVolumes::new(bounds, cell);
+        v.add_mesh(mesh);
+        v
     }
 }
 

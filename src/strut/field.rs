@@ -207,6 +207,49 @@ impl StrutField {
         d.min(self.reach)
     }
 
+    /// The value at `p` at radius `r` (at most the radius the field was built for), its
+    /// gradient in `p`, and the radius factor of the nearest struts (the value's slope against
+    /// `r` is minus it). With sharp joins, the nearest strut's distance and gradient, from two
+    /// passes over the struts of `p`'s bin instead of seven. Where struts tie for nearest
+    /// (within the step central differences would take: on the mirror planes of a symmetric
+    /// node, which the voxel grid often samples exactly) their gradients are averaged, as
+    /// central differences average the one-sided slopes of a crease — so the result does not
+    /// depend on the order the cell lists its struts in. (Blended joins are differentiated
+    /// numerically, their factor the mean of the cell's.)
+    pub fn gradient_at(&self, p: Vec3, r: f64) -> (f64, Vec3, f64) {
+        if self.blend > 0.0 {
+            let n = self.struts.len().max(1) as f64;
+            let f = self.struts.iter().map(|s| 0.5 * (s.fa + s.fb)).sum::<f64>() / n;
+            return (
+                self.value_at(p, r),
+                numeric_gradient(|q| self.value_at(q, r), p),
+                f,
+            );
+        }
+        let (q, bin) = self.locate(p);
+        let near = &self.bins[bin];
+        let d = near
+            .iter()
+            .map(|&i| self.struts[i as usize].distance(q, r))
+            .fold(self.reach, f64::min);
+        if d >= self.reach {
+            // Beyond the reach the value is constant.
+            return (self.reach, [0.0; 3], 0.0);
+        }
+        let tie = 1e-6 * (1.0 + p.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+        let (mut g, mut f, mut n) = ([0.0; 3], 0.0, 0.0);
+        for &i in near {
+            let s = &self.struts[i as usize];
+            if s.distance(q, r) <= d + tie {
+                let gi = s.gradient(q, r);
+                g = [0, 1, 2].map(|a| g[a] + gi[a]);
+                f += 0.5 * (s.fa + s.fb);
+                n += 1.0;
+            }
+        }
+        (d, g.map(|x| x / n), f / n)
+    }
+
     /// The distance from `p` to the nearest strut axis, each over the strut's mean radius
     /// factor (up to the reach): the radius at which a capsule lattice first holds `p`.
     pub fn axis_distance(&self, p: Vec3) -> f64 {
@@ -277,41 +320,28 @@ impl Field for StrutField {
         (v, v.abs())
     }
 
-    /// With sharp joins, the nearest strut's distance and gradient, from two passes over the
-    /// struts of `p`'s bin instead of seven. Where struts tie for nearest (within the step
-    /// central differences would take: on the mirror planes of a symmetric node, which the voxel
-    /// grid often samples exactly) their gradients are averaged, as central differences average
-    /// the one-sided slopes of a crease — so the result does not depend on the order the cell
-    /// lists its struts in. (Blended joins are differentiated numerically.)
+    /// See [`StrutField::gradient_at`].
     fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
-        if self.blend > 0.0 {
-            return (self.value(p), numeric_gradient(|q| self.value(q), p));
-        }
-        let (q, bin) = self.locate(p);
-        let r = self.radius;
-        let near = &self.bins[bin];
-        let d = near
-            .iter()
-            .map(|&i| self.struts[i as usize].distance(q, r))
-            .fold(self.reach, f64::min);
-        if d >= self.reach {
-            // Beyond the reach the value is constant.
-            return (self.reach, [0.0; 3]);
-        }
-        let tie = 1e-6 * (1.0 + p.iter().fold(0.0f64, |m, x| m.max(x.abs())));
-        let (mut g, mut n) = ([0.0; 3], 0.0);
-        for &i in near {
-            let s = &self.struts[i as usize];
-            if s.distance(q, r) <= d + tie {
-                let gi = s.gradient(q, r);
-                g = [0, 1, 2].map(|a| g[a] + gi[a]);
-                n += 1.0;
-            }
-        }
-        (d, g.map(|x| x / n))
+        let (d, g, _) = self.gradient_at(p, self.radius);
+        (d, g)
     }
 
     fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
+        self.sample_block_at(origin, h, out, |_, _, _| self.radius)
+    }
+}
+
+impl StrutField {
+    /// Samples the 8³ block at `origin`, spacing `h`, the sample `(i, j, k)` at radius
+    /// `radius(i, j, k)` (at most the radius the field was built for).
+    #[inline(always)]
+    pub fn sample_block_at(
+        &self,
+        origin: Vec3,
+        h: f64,
+        out: &mut [f32; 512],
+        radius: impl Fn(usize, usize, usize) -> f64,
+    ) {
         let mut axes = [[(0.0, 0usize); 8]; 3];
         for (a, axis) in axes.iter_mut().enumerate() {
             let u = periodic::block_axis(
@@ -333,7 +363,7 @@ impl Field for StrutField {
                         [axes[0][i].0, axes[1][j].0, axes[2][k].0],
                         (axes[0][i].1 * BINS + axes[1][j].1) * BINS + axes[2][k].1,
                     );
-                    out[(i * 8 + j) * 8 + k] = self.local_value(q, bin, self.radius) as f32;
+                    out[(i * 8 + j) * 8 + k] = self.local_value(q, bin, radius(i, j, k)) as f32;
                 }
             }
         }

@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::field::{Aabb, Domain};
 use crate::io::sink::{MeshCollector, MeshSink};
 use crate::io::threemf::BeamModel;
+use crate::mesh::graded::{Grading, GradingReport};
 use crate::mesh::pipeline::{self, Family, Measured, MeshingStats, Options, Route};
 use crate::mesh::report::{LevelSearch, PartReport, Timings};
 use crate::mesh::resolution::{self, max_resolution, Resolved};
@@ -53,6 +54,8 @@ pub struct StrutJob {
     pub auto_resolution: bool,
     /// The pipeline's options.
     pub options: Options,
+    /// A density that varies through the part, instead of `sizing`.
+    pub grading: Option<Grading>,
 }
 
 /// The radii (and densities) a cell can be built at.
@@ -97,6 +100,8 @@ pub struct StrutReport {
     pub cell_size: [f64; 3],
     /// Cells per axis (fractional where the box ends inside a cell).
     pub cells: [f64; 3],
+    /// How a graded part met its density field, cell by cell (its `radius` is the mean).
+    pub grading: Option<GradingReport>,
     /// The part as written: density, mesh, checks, timings, warnings.
     #[serde(flatten)]
     pub part: PartReport,
@@ -198,6 +203,11 @@ impl StrutJob {
     /// the density.
     pub fn model(&self) -> Result<crate::render::Model> {
         self.validate()?;
+        if self.grading.is_some() {
+            return Err(Error::invalid(
+                "a graded part is drawn and sliced from its mesh: make it with -o part.stl, then render, view or slice part.stl",
+            ));
+        }
         let bounds = self.domain.bounds();
         let radius = match self.sizing {
             Sizing::Radius(r) => r,
@@ -220,13 +230,13 @@ impl StrutJob {
     }
 
     /// The voxel edge at `resolution` voxels per cell, mm.
-    fn voxel(&self, resolution: u32) -> f64 {
+    pub(super) fn voxel(&self, resolution: u32) -> f64 {
         let c = self.domain.cell;
         c[0].min(c[1]).min(c[2]) / resolution as f64
     }
 
     /// The smallest radius factor: the thinnest strut is the radius times it.
-    fn thinnest_factor(&self) -> f64 {
+    pub(super) fn thinnest_factor(&self) -> f64 {
         self.cell
             .radii
             .iter()
@@ -235,7 +245,7 @@ impl StrutJob {
     }
 
     /// The radii and densities the cell allows at `resolution`.
-    fn range(&self, model: &RadiusModel, resolution: u32) -> StrutRange {
+    pub(super) fn range(&self, model: &RadiusModel, resolution: u32) -> StrutRange {
         let min_radius = 0.5 * MIN_STRUT_VOXELS * self.voxel(resolution) / self.thinnest_factor();
         StrutRange {
             min_radius,
@@ -246,7 +256,7 @@ impl StrutJob {
     }
 
     /// The lattice's family of radii, its model measured (and the seconds that took).
-    fn family(&self) -> (StrutFamily, f64) {
+    pub(super) fn family(&self) -> (StrutFamily, f64) {
         let t = Instant::now();
         let bounds = self.domain.bounds();
         let family = StrutFamily::new(StrutLattice {
@@ -328,6 +338,9 @@ impl StrutJob {
     pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<StrutReport> {
         let start = Instant::now();
         self.validate()?;
+        if let Some(g) = &self.grading {
+            return self.run_graded(g, progress, sink);
+        }
         let (family, model_seconds) = self.family();
         let resolved = self.search(&family, progress)?;
         let Found {
@@ -370,6 +383,7 @@ impl StrutJob {
             voxel_size: voxel,
             cell_size: self.domain.cell,
             cells: self.domain.counts(),
+            grading: None,
             part,
         })
     }
@@ -380,6 +394,11 @@ impl StrutJob {
     pub fn beams(&self, progress: &Progress) -> Result<(BeamModel, BeamsReport)> {
         let start = Instant::now();
         self.validate()?;
+        if self.grading.is_some() {
+            return Err(Error::invalid(
+                "a graded lattice is written as a mesh: drop --beams",
+            ));
+        }
         if self.blend > 0.0 {
             return Err(Error::invalid(
                 "blended joints cannot be written as beams (3MF beams are capsules and balls): drop --blend, or write a mesh",
@@ -422,7 +441,7 @@ impl StrutJob {
     /// The resolution struts of radius `r` need, when the requested one leaves them thinner
     /// than [`MIN_STRUT_VOXELS`], and why; refused when even the finest resolution searched
     /// would not do.
-    fn thin_struts(&self, r: f64) -> Result<Option<(u32, String)>> {
+    pub(super) fn thin_struts(&self, r: f64) -> Result<Option<(u32, String)>> {
         let req = self.resolution;
         let across = 2.0 * r * self.thinnest_factor() / self.voxel(req);
         if across >= MIN_STRUT_VOXELS {

@@ -52,7 +52,7 @@ pub struct TpmsJob {
     /// Keep the fragments the box cuts loose from the lattice (removed by default).
     pub keep_fragments: bool,
     /// A density that varies through the part (`density` is then not used).
-    pub grading: Option<super::graded::Grading>,
+    pub grading: Option<crate::mesh::graded::Grading>,
 }
 
 /// The JSON report of a TPMS job.
@@ -87,7 +87,7 @@ pub struct TpmsReport {
     pub cells: [f64; 3],
     /// How a graded part met its density field, cell by cell.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub grading: Option<super::graded::GradingReport>,
+    pub grading: Option<crate::mesh::graded::GradingReport>,
     /// The part as written: density, mesh, checks, timings, warnings.
     #[serde(flatten)]
     pub part: PartReport,
