@@ -30,6 +30,7 @@ fn main() {
     let resolution = (cell / voxel).round() as u32;
     let t = Instant::now();
     let job = FillJob {
+        grading: None,
         part: torus(0.35 * size, 0.15 * size, 512, 256),
         part_name: format!("a torus {size} mm across"),
         keep: Vec::new(),

@@ -5,6 +5,7 @@
 //! CGAL's checks in the report.
 
 mod common;
+mod meshkit;
 use common::*;
 use std::path::Path;
 
@@ -12,6 +13,7 @@ use std::path::Path;
 struct Measured {
     status: String,
     components: u64,
+    solids: u64,
     volume: f64,
     /// `([i, j, k], fraction)` per cell.
     cells: Vec<([usize; 3], f64)>,
@@ -31,6 +33,7 @@ fn measure(stl: &Path, origin: [f64; 3], cell: [f64; 3], size: [f64; 3]) -> Meas
     Measured {
         status: v["status"].as_str().unwrap().to_string(),
         components: v["components"].as_u64().unwrap(),
+        solids: v["solids"].as_u64().unwrap(),
         volume: v["volume"].as_f64().unwrap(),
         cells: v["cells"]
             .as_array()
@@ -56,6 +59,19 @@ fn check_graded(
     size: [f64; 3],
     field: &dyn Fn([f64; 3]) -> f64,
 ) -> f64 {
+    let whole = |lo: [f64; 3]| (0..3).all(|a| lo[a] + cell[a] <= origin[a] + size[a] + 1e-9);
+    check_cells(args, origin, cell, size, field, &whole)
+}
+
+/// As [`check_graded`], the cells checked those whose lower corner `promised` accepts.
+fn check_cells(
+    args: &[&str],
+    origin: [f64; 3],
+    cell: [f64; 3],
+    size: [f64; 3],
+    field: &dyn Fn([f64; 3]) -> f64,
+    promised: &dyn Fn([f64; 3]) -> bool,
+) -> f64 {
     let dir = tempdir();
     let mut all = args.to_vec();
     all.extend([
@@ -78,7 +94,11 @@ fn check_graded(
     assert_eq!(r["grading"]["cells_met"], true, "{args:?}");
     let m = measure(&dir.path().join("part.stl"), origin, cell, size);
     assert_eq!(m.status, "Error.NoError", "{args:?}: manifold3d");
-    assert_eq!(m.components, 1, "{args:?}: one component");
+    assert_eq!(m.solids, 1, "{args:?}: one solid");
+    if args[0] != "fill" {
+        // A skin encloses the lattice's void: shells of their own.
+        assert_eq!(m.components, 1, "{args:?}: one component");
+    }
     let stl_volume = volume(&read_stl(&dir.path().join("part.stl")));
     assert!(
         (m.volume - stl_volume).abs() < 1e-6 * stl_volume,
@@ -88,7 +108,7 @@ fn check_graded(
     let mut whole = 0;
     for (c, fraction) in &m.cells {
         let lo = [0, 1, 2].map(|a| origin[a] + c[a] as f64 * cell[a]);
-        if (0..3).any(|a| lo[a] + cell[a] > origin[a] + size[a] + 1e-9) {
+        if !promised(lo) {
             continue;
         }
         whole += 1;
@@ -160,6 +180,84 @@ fn a_bcc_block_graded_along_z_meets_the_grade_in_every_cell() {
         &|p| 0.1 + 0.3 * p[2] / 30.0,
     );
     assert!(worst < 0.005, "{worst}");
+}
+
+/// The must-show fill: a 30 mm cube with a 1 mm skin, its gyroid core dense near the skin and
+/// open inside (`d`, the depth below the skin); every cell wholly inside the core (here, away
+/// from the cube's faces by more than the skin) meets the field at its centre, the depth there
+/// computed by this test from the cube's faces.
+#[test]
+fn a_fill_graded_by_depth_below_the_skin_meets_it_in_every_core_cell() {
+    let dir = tempdir();
+    let cube = dir.path().join("cube.stl");
+    meshkit::write_stl(&cube, &meshkit::cuboid([0.0; 3], [30.0; 3]));
+    let depth = |p: [f64; 3]| {
+        (0..3)
+            .map(|a| p[a].min(30.0 - p[a]))
+            .fold(f64::INFINITY, f64::min)
+            - 1.0
+    };
+    let worst = check_cells(
+        &[
+            "fill",
+            cube.to_str().unwrap(),
+            "--skin",
+            "1",
+            "--lattice",
+            "gyroid",
+            "--cell-size",
+            "5",
+            "--density-field",
+            "max(0.12, 0.35 - 0.03*d)",
+            "-r",
+            "24",
+        ],
+        [0.0; 3],
+        [5.0; 3],
+        [30.0; 3],
+        &|p| (0.35 - 0.03 * depth(p).max(0.0)).max(0.12),
+        &|lo| (0..3).all(|a| lo[a] >= 1.0 && lo[a] + 5.0 <= 29.0),
+    );
+    assert!(worst < 0.005, "{worst}");
+}
+
+/// Struts filling a ball, graded along z across its box (no skin: the lattice cut by the
+/// sphere); the cells wholly inside the ball meet the grade.
+#[test]
+fn a_strut_fill_graded_along_z_meets_it_in_every_inner_cell() {
+    let dir = tempdir();
+    let ball = dir.path().join("ball.stl");
+    let tris = meshkit::sphere(14.0, 96);
+    meshkit::write_stl(&ball, &tris);
+    let (lo, hi) = bounds(&tris);
+    let origin = lo;
+    let size = [0, 1, 2].map(|a| hi[a] - lo[a]);
+    check_cells(
+        &[
+            "fill",
+            ball.to_str().unwrap(),
+            "--no-skin",
+            "--lattice",
+            "bcc",
+            "--cell-size",
+            "4",
+            "--density-grade",
+            "z:0.1:0.3",
+            "-r",
+            "20",
+        ],
+        origin,
+        [4.0; 3],
+        size,
+        &|p| 0.1 + 0.2 * ((p[2] - origin[2]) / size[2]).clamp(0.0, 1.0),
+        // Every corner of the cell at least half a millimetre inside the (faceted) sphere.
+        &|lo| {
+            (0..8).all(|c| {
+                let p = [0, 1, 2].map(|a| lo[a] + 4.0 * ((c >> a) & 1) as f64);
+                (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() <= 13.5
+            })
+        },
+    );
 }
 
 /// Strut cells graded at random (seeded): cell, axis, the grade's ends, a box that may end
@@ -430,6 +528,44 @@ fn bad_strut_gradings_are_refused() {
     }
 }
 
+/// Bad fill gradings: a field that leaves (0, 1) deep in the core, a density beside the field:
+/// refused with one line, exit 2, no file.
+#[test]
+fn bad_fill_gradings_are_refused() {
+    let dir = tempdir();
+    meshkit::write_stl(
+        &dir.path().join("cube.stl"),
+        &meshkit::cuboid([0.0; 3], [20.0; 3]),
+    );
+    let before = files_in(dir.path());
+    let cases: [(&[&str], &str); 3] = [
+        (
+            &["--density-field", "0.4 - 0.05*d"],
+            "volume fractions in (0, 1)",
+        ),
+        (
+            &["--density-field", "0.3", "--density", "0.2"],
+            "cannot be used with",
+        ),
+        (&["--density-field", "0.3 + w"], "unknown name 'w'"),
+    ];
+    for (extra, what) in cases {
+        let mut args = vec![
+            "fill",
+            "cube.stl",
+            "--cell-size",
+            "5",
+            "-r",
+            "12",
+            "-o",
+            "x.stl",
+        ];
+        args.extend_from_slice(extra);
+        let out = run(&args, dir.path());
+        assert_refusal(dir.path(), &before, &out, &args, what);
+    }
+}
+
 /// A graded part's settings saved as a part file (its sampled field by path) make the same
 /// part again from another folder; drawing it from the part file is refused with a pointer to
 /// its mesh.
@@ -440,6 +576,11 @@ fn graded_parts_are_saved_as_part_files() {
     let mut bytes = Vec::new();
     latvox::io::npy::write(&mut bytes, &[2, 2, 2], &data).unwrap();
     std::fs::write(dir.path().join("f.npy"), bytes).unwrap();
+    meshkit::write_stl(
+        &dir.path().join("cube.stl"),
+        &meshkit::cuboid([0.0; 3], [12.0; 3]),
+    );
+    let boxed = ["--cells", "2", "-r", "12"];
     for (command, field, name) in [
         ("tpms", vec!["--density-field", "f.npy"], "a"),
         (
@@ -448,9 +589,25 @@ fn graded_parts_are_saved_as_part_files() {
             "b",
         ),
         ("strut", vec!["--density-grade", "x:0.1:0.25"], "c"),
+        (
+            "fill",
+            vec![
+                "cube.stl",
+                "--cell-size",
+                "4",
+                "-r",
+                "12",
+                "--density-field",
+                "0.3 - 0.02*d",
+            ],
+            "d",
+        ),
     ] {
         let (stl, toml) = (format!("{name}.stl"), format!("{name}.toml"));
-        let mut args = vec![command, "--cells", "2", "-r", "12", "-q", "-o", &stl];
+        let mut args = vec![command, "-q", "-o", &stl];
+        if command != "fill" {
+            args.extend(boxed);
+        }
         args.extend(field);
         args.extend(["--save-part", &toml]);
         ok(&args, dir.path());

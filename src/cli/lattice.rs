@@ -24,8 +24,9 @@ pub struct GradeArgs {
     /// whole cell meets the grade at its centre within ±0.01.
     #[arg(long, value_name = "AXIS:A:B", conflicts_with = "density_field")]
     pub density_grade: Option<String>,
-    /// Grade the density by a field: an expression in x, y, z (mm; as "0.15 + 0.1*sin(PI*x/20)")
-    /// or a .npy array of shape (NX, NY, NZ) sampled over the box, corners on its corners.
+    /// Grade the density by a field: an expression in x, y, z (mm; as "0.15 + 0.1*sin(PI*x/20)";
+    /// for fill also d, the depth below the skin) or a .npy array of shape (NX, NY, NZ) sampled
+    /// over the box, corners on its corners.
     #[arg(long, value_name = "EXPR|FILE.npy", allow_hyphen_values = true)]
     pub density_field: Option<String>,
     /// Hold a density field to the type's feasible range instead of refusing it (reported).

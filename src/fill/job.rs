@@ -11,6 +11,7 @@ use crate::check::Verdict;
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Vec3};
 use crate::io::sink::{MeshCollector, MeshSink};
+use crate::mesh::graded::{Grading, GradingReport};
 use crate::mesh::pipeline::{self, Family, Measured, MeshingStats, Options, Route};
 use crate::mesh::report::{LevelSearch, PartReport, Timings};
 use crate::mesh::resolution::{self, Resolved};
@@ -75,6 +76,9 @@ pub struct FillJob {
     pub auto_resolution: bool,
     /// The pipeline's options.
     pub options: Options,
+    /// A density that varies through the part (of `x, y, z` and `d`, the depth below the
+    /// skin), instead of `density`.
+    pub grading: Option<Grading>,
 }
 
 /// The JSON report of a fill job.
@@ -117,6 +121,9 @@ pub struct FillReport {
     pub voxel_size: f64,
     /// Memory of the part's distance grids, bytes.
     pub distance_grid_bytes: u64,
+    /// How a graded fill met its density field, cell by cell (the cells wholly inside the core
+    /// are promised); its `level` is the mean.
+    pub grading: Option<GradingReport>,
     /// The part as written: `target_density` and `achieved_density` are the lattice's share of
     /// the fill region; mesh, checks, fragments (lattice pieces the part's surface cut loose,
     /// removed), timings, warnings.
@@ -144,6 +151,23 @@ struct Found<F: Family> {
     grid_bytes: u64,
 }
 
+/// The job's part and kept solids, closed, and what closing the part changed.
+pub(super) fn closed_parts(
+    job: &FillJob,
+    progress: &Progress,
+) -> Result<(Mesh, Vec<Mesh>, Vec<Change>)> {
+    let (part, changes) = {
+        let _p = progress.stage("checking the part is closed");
+        closed(&job.part, &job.part_name)?
+    };
+    let keep = job
+        .keep
+        .iter()
+        .map(|(name, m)| closed(m, name).map(|(m, _)| m))
+        .collect::<Result<Vec<_>>>()?;
+    Ok((part, keep, changes))
+}
+
 /// Closes `mesh` with latvox's repair, or refuses it naming what stays open.
 pub fn closed(mesh: &Mesh, name: &str) -> Result<(Mesh, Vec<Change>)> {
     if mesh.triangle_count() == 0 {
@@ -168,8 +192,22 @@ pub fn closed(mesh: &Mesh, name: &str) -> Result<(Mesh, Vec<Change>)> {
 
 impl FillJob {
     /// The part's and the kept solids' distance grids at `voxel` mm, with the drain holes.
-    fn shape(&self, part: &Mesh, keep: &[Mesh], voxel: f64) -> Result<Arc<Shape>> {
-        let mut shape = Shape::new(part, keep, voxel, self.skin + self.blend)?;
+    pub(super) fn shape(&self, part: &Mesh, keep: &[Mesh], voxel: f64) -> Result<Arc<Shape>> {
+        let mut depth = self.skin + self.blend;
+        if self
+            .grading
+            .as_ref()
+            .is_some_and(|g| g.field.uses_distance())
+        {
+            // The field reads the depth below the skin everywhere: the grid is exact through
+            // the whole part (no point lies deeper than half its smallest extent).
+            let b = part.bounds().expect("a part has triangles");
+            let least = (0..3)
+                .map(|a| b.max[a] - b.min[a])
+                .fold(f64::INFINITY, f64::min);
+            depth = depth.max(0.5 * least + voxel);
+        }
+        let mut shape = Shape::new(part, keep, voxel, depth)?;
         if let (Some(d), true) = (self.drain, self.skin > 0.0) {
             self.check_drain(part, d)?;
             shape.drains = Drain::at_ends(part, d, self.skin + self.blend + voxel);
@@ -226,15 +264,10 @@ impl FillJob {
     pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<FillReport> {
         let start = Instant::now();
         self.validate()?;
-        let (part, changes) = {
-            let _p = progress.stage("checking the part is closed");
-            closed(&self.part, &self.part_name)?
-        };
-        let keep = self
-            .keep
-            .iter()
-            .map(|(name, m)| closed(m, name).map(|(m, _)| m))
-            .collect::<Result<Vec<_>>>()?;
+        if let Some(g) = &self.grading {
+            return self.run_graded(g, progress, sink);
+        }
+        let (part, keep, changes) = closed_parts(self, progress)?;
         match &self.lattice {
             Infilling::Tpms { surface, structure } => {
                 let (s, st) = (*surface, *structure);
@@ -272,7 +305,7 @@ impl FillJob {
                         model.fraction(model.closing),
                     )));
                 }
-                let factor = cell.radii.iter().cloned().fold(f64::INFINITY, f64::min);
+                let factor = cell.thinnest_factor();
                 let across = 2.0 * r0 * factor * self.resolution as f64 / self.min_cell();
                 let make = |bounds: Aabb, phase: Vec3| StrutFamily {
                     part: StrutLattice {
@@ -303,7 +336,7 @@ impl FillJob {
     /// The resolution the lattice's members (`members`: their width in voxels at the requested
     /// resolution, the least they need, and what they are) and the skin need, when the
     /// requested one falls short, and why.
-    fn thin(&self, members: Option<(f64, f64, &str)>) -> Option<(u32, String)> {
+    pub(super) fn thin(&self, members: Option<(f64, f64, &str)>) -> Option<(u32, String)> {
         let r = self.resolution;
         let mut needs: Vec<(u32, String)> = Vec::new();
         if let Some((w, min, what)) = members.filter(|(w, min, _)| w < min) {
@@ -478,6 +511,7 @@ impl FillJob {
             resolution: resolved.resolution,
             voxel_size: voxel,
             distance_grid_bytes: grid_bytes,
+            grading: None,
             part: report,
         })
     }

@@ -153,6 +153,23 @@ impl Shape {
         })
     }
 
+    /// How deep `p` lies inside the part, mm (negative outside): exact down to the depth the
+    /// grid was built for, within the grid's interpolation.
+    pub fn depth(&self, p: Vec3) -> f64 {
+        -self.part.value_at(p)
+    }
+
+    /// Whether the box `b` lies wholly `below` mm or more inside the part's surface, clear of
+    /// the kept solids and the drain holes (from the distances at its centre, each 1-Lipschitz).
+    pub fn holds(&self, b: &Aabb, below: f64) -> bool {
+        let c = b.centre();
+        let s = b.size();
+        let r = 0.5 * (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+        self.depth(c) - r >= below
+            && self.keep.iter().all(|g| g.value_at(c) >= r)
+            && self.drilled(c) >= r
+    }
+
     /// The distance to the drain holes (negative inside one; infinite without holes).
     fn drilled(&self, p: Vec3) -> f64 {
         self.drains

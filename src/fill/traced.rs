@@ -44,6 +44,11 @@ impl FillJob {
     /// The filled part for tracing: the part's and the kept solids' meshes (closed first, as
     /// for meshing) and the lattice at the level (or radius) its model gives for the density.
     pub fn traced(&self) -> Result<Traced> {
+        if self.grading.is_some() {
+            return Err(crate::error::Error::invalid(
+                "a graded part is drawn and sliced from its mesh: make it with -o part.stl, then render, view or slice part.stl",
+            ));
+        }
         let (part, _) = closed(&self.part, &self.part_name)?;
         let keep = self
             .keep

@@ -14,7 +14,9 @@
 //! OpenVDB gave it). Where the surface meets a clip plane at a grazing angle, snapping can still
 //! tip a sliver triangle through its neighbour: every triangle whose normal turned by more than
 //! [`MAX_TURN_DEGREES`] is found and its vertices are returned to OpenVDB's positions, repeatedly,
-//! until none is.
+//! until none is. And where a thin member meets the box, two vertices snapped onto the face can
+//! swap places along it without turning a triangle over: triangles on the box's faces that cross
+//! one another are found exactly and their vertices restored the same way.
 
 use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
@@ -98,7 +100,7 @@ pub fn snap_within(
         }
     }
     mesh.triangulate();
-    s.restored = unfold(mesh, spec);
+    s.restored = unfold(mesh, spec) + untangle_rims(mesh, clip, spec);
     s
 }
 
@@ -134,6 +136,79 @@ pub fn unfold(mesh: &mut KeyedMesh, spec: &GridSpec) -> u64 {
         let mut changed = false;
         for v in bad {
             let o = original(mesh, v);
+            let p = &mut mesh.positions[v as usize];
+            if *p != o {
+                *p = o;
+                restored += 1;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    restored
+}
+
+/// Returns to OpenVDB's positions the vertices of triangles on the clip box's faces (two or
+/// more corners on a face) that snapping left crossing one another: where a thin member meets
+/// the box, two rim vertices snapped onto the face's curve from neighbouring cells can swap
+/// places along it without turning either triangle over. Each rim triangle is tested exactly
+/// against those of its voxel's neighbours; repeats for at most [`UNFOLD_PASSES`] passes. Returns
+/// how many were restored.
+fn untangle_rims(mesh: &mut KeyedMesh, clip: &Aabb, spec: &GridSpec) -> u64 {
+    use crate::check::self_intersect::exact::{facets_intersect, Facet};
+    use crate::mesh::{cross, norm, sub};
+    use std::collections::HashMap;
+    let on_clip = |p: Vec3| (0..3).any(|a| p[a] == clip.min[a] || p[a] == clip.max[a]);
+    let mut restored = 0u64;
+    for _ in 0..UNFOLD_PASSES {
+        let m = &*mesh;
+        let rims: Vec<[u32; 3]> = (0..m.quads.len())
+            .into_par_iter()
+            .flat_map_iter(|q| {
+                let (t, u) = m.quad_triangles(q);
+                std::iter::once(t).chain(u)
+            })
+            .filter(|t| {
+                let p = t.map(|v| m.positions[v as usize]);
+                p.iter().filter(|p| on_clip(**p)).count() >= 2
+                    && norm(cross(sub(p[1], p[0]), sub(p[2], p[0]))) > 0.0
+            })
+            .collect();
+        if rims.is_empty() {
+            break;
+        }
+        let mut cells: HashMap<[i32; 3], Vec<usize>> = HashMap::new();
+        for (i, t) in rims.iter().enumerate() {
+            cells
+                .entry(m.keys[t[0] as usize].voxel)
+                .or_default()
+                .push(i);
+        }
+        let facet = |t: &[u32; 3]| Facet::new(*t, t.map(|v| m.positions[v as usize]));
+        let bad: Vec<u32> = (0..rims.len())
+            .into_par_iter()
+            .flat_map_iter(|i| {
+                let (t, k) = (rims[i], m.keys[rims[i][0] as usize].voxel);
+                let f = facet(&t);
+                let mut out = Vec::new();
+                for n in 0..27 {
+                    let d = [n / 9, n / 3 % 3, n % 3].map(|x| x - 1);
+                    let key = [k[0] + d[0], k[1] + d[1], k[2] + d[2]];
+                    for &j in cells.get(&key).map_or(&[][..], Vec::as_slice) {
+                        if j > i && facets_intersect(&f, &facet(&rims[j])) {
+                            out.extend(t);
+                            out.extend(rims[j]);
+                        }
+                    }
+                }
+                out
+            })
+            .collect();
+        let mut changed = false;
+        for v in bad {
+            let o = position(spec, mesh.keys[v as usize].voxel, mesh.offsets[v as usize]);
             let p = &mut mesh.positions[v as usize];
             if *p != o {
                 *p = o;

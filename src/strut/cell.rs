@@ -227,6 +227,11 @@ fn rhombic() -> Vec<[Vec3; 2]> {
 }
 
 impl UnitCell {
+    /// The smallest radius factor: the thinnest strut is the radius times it.
+    pub fn thinnest_factor(&self) -> f64 {
+        self.radii.iter().cloned().fold(f64::INFINITY, f64::min)
+    }
+
     /// A built-in cell by name (see [`BUILT_IN`]).
     pub fn built_in(name: &str) -> Result<UnitCell> {
         let segments = match name {

@@ -114,7 +114,7 @@ impl Levelled for StrutFamily {
 /// The cell's density → radius map over `[lo, hi]` at `voxel`: one cell (a box of one period,
 /// which holds exactly the lattice's fraction) meshed at each knot and its radius found by the
 /// pipeline's search; whether every search met its density.
-fn calibrate(
+pub(crate) fn calibrate(
     family: &StrutFamily,
     voxel: f64,
     opts: &Options,

@@ -237,11 +237,7 @@ impl StrutJob {
 
     /// The smallest radius factor: the thinnest strut is the radius times it.
     pub(super) fn thinnest_factor(&self) -> f64 {
-        self.cell
-            .radii
-            .iter()
-            .cloned()
-            .fold(f64::INFINITY, f64::min)
+        self.cell.thinnest_factor()
     }
 
     /// The radii and densities the cell allows at `resolution`.

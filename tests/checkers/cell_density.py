@@ -5,7 +5,9 @@ Usage: cell_density.py MESH ORIGIN_X,Y,Z CELL_X,Y,Z SIZE_X,Y,Z
 The mesh (read by trimesh, its vertices merged) must be a manifold solid for manifold3d. It is
 cut into slabs along x, each slab along y, each of those along z, at the cells' faces (the box
 cut into cells from its lower corner, partial cells at the far sides), and each piece's volume
-taken. Prints JSON: {"status", "components", "volume", "cells": [[i, j, k, fraction], ...]}.
+taken. Prints JSON: {"status", "components" (connected shells), "solids" (shells enclosing
+positive volume: a void inside a skin is a shell of its own), "volume",
+"cells": [[i, j, k, fraction], ...]}.
 """
 import json
 import math
@@ -57,6 +59,8 @@ def main():
     print(json.dumps({
         "status": status,
         "components": len(solid.decompose()),
+        # Shells enclosing solid (a void's shell, inside-out, encloses negative volume).
+        "solids": sum(1 for c in solid.decompose() if c.volume() > 0),
         "volume": solid.volume(),
         "cells": cells,
     }))
