@@ -135,3 +135,41 @@ fn a_custom_cell_that_repeats_bcc_gives_bccs_volume() {
         "bcc {a} mm³, the cell file {b} mm³"
     );
 }
+
+/// Where thin struts meet the box, two rim vertices snapped onto a face from neighbouring cells
+/// can swap places along it: an octet truss at 15 % in this box once wrote crossing triangles on
+/// its x face. CGAL finds the written part free of self-intersections.
+#[test]
+fn thin_struts_cut_by_the_box_leave_no_crossing_triangles() {
+    let dir = tempdir();
+    ok(
+        &[
+            "strut",
+            "--cell",
+            "octet",
+            "--density",
+            "0.15",
+            "--size",
+            "11.514829069883385,10.813838866363737,12.649712343566318",
+            "--cell-size",
+            "4.80342141536725",
+            "--origin",
+            "14.48609766145924,-11.05265645115535,-8.790671405272938",
+            "-r",
+            "22",
+            "--no-instancing",
+            "--verify",
+            "cgal",
+            "-q",
+            "-o",
+            "part.stl",
+            "--report",
+            "part.json",
+        ],
+        dir.path(),
+    );
+    let r = json(&dir.path().join("part.json"));
+    assert_eq!(r["checks"]["checked_by"], "CGAL");
+    assert_eq!(r["checks"]["self_intersecting"], false);
+    assert_eq!(r["checks"]["closed"], true);
+}
