@@ -80,7 +80,10 @@ class Draw:
             return  # not active in this variant, as the page's set() skips it
         if isinstance(value, np.ndarray):
             n = u.array_length * u.dimension
-            u.write(value.reshape(-1)[:n].tobytes())
+            flat = value.reshape(-1)[:n]
+            # An array shorter than the shader's is padded, as WebGL leaves the rest zero.
+            flat = np.concatenate([flat, np.zeros(n - flat.size, flat.dtype)])
+            u.write(flat.tobytes())
         else:
             u.value = value
 
@@ -125,9 +128,7 @@ class Draw:
         self.set("uAoReach", s["cell"] / 6)
         if s["kind"] == "tpms":
             t = s["tpms"]
-            terms = np.zeros(32, "f4")
-            for i, row in enumerate(t["terms"]):
-                terms[4 * i:4 * i + 4] = row
+            terms = np.array(t["terms"], "f4").reshape(-1)
             self.set("uKind", 0)
             self.set("uTerms", terms)
             self.set("uTermCount", len(t["terms"]))
