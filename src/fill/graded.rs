@@ -18,7 +18,7 @@ use crate::mesh::graded::{
     self, Cells, Feasible, Graded, GradedFamily, GradedPart, Grading, LevelGrid, LevelMap,
     Levelled, Run,
 };
-use crate::mesh::pipeline::{self, Options, Route};
+use crate::mesh::pipeline::Options;
 use crate::mesh::report::Timings;
 use crate::mesh::resolution::max_resolution;
 use crate::progress::Progress;
@@ -191,32 +191,10 @@ impl FillJob {
         }
         let voxel = self.min_cell() / resolution as f64;
         let opts = Options {
-            memory: Some(
-                self.options
-                    .memory
-                    .unwrap_or(pipeline::DEFAULT_MEMORY)
-                    .saturating_sub(shape.memory_bytes()),
-            ),
             instancing: false,
-            ..self.options
+            ..self.beside(&shape, &self.options)
         };
-        let solid = |infill| FillSolid {
-            shape: shape.clone(),
-            skin: self.skin,
-            blend: self.blend,
-            infill,
-        };
-        let part_route = Route::choose(&solid(Infill::<Lattice>::Full), voxel, &opts);
-        let (whole, _) = {
-            let _p = progress.stage("measuring the part");
-            pipeline::solid_volume(&solid(Infill::<Lattice>::Full), voxel, part_route)?
-        };
-        let base = if self.skin == 0.0 && keep.is_empty() {
-            0.0
-        } else {
-            let _p = progress.stage("measuring the skin");
-            pipeline::solid_volume(&solid(Infill::<Lattice>::Empty), voxel, part_route)?.0
-        };
+        let (whole, base, _) = self.regions(&shape, &keep, voxel, &opts, progress)?;
         let cal_start = Instant::now();
         let (lo, hi) = (targets.built[0], targets.built[1]);
         let (bounds, cell) = (shape.bounds, self.cell);

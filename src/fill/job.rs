@@ -215,6 +215,58 @@ impl FillJob {
         Ok(Arc::new(shape))
     }
 
+    /// The pipeline's options beside `shape`'s distance grid, which is held throughout: the
+    /// meshing gets the rest of the budget.
+    pub(super) fn beside(&self, shape: &Shape, opts: &Options) -> Options {
+        Options {
+            memory: Some(
+                opts.memory
+                    .unwrap_or(pipeline::DEFAULT_MEMORY)
+                    .saturating_sub(shape.memory_bytes()),
+            ),
+            ..*opts
+        }
+    }
+
+    /// The volume of the whole part and of its skin and kept solids alone on `voxel`, mm³, and
+    /// the meshings that measured them; refused when the skin leaves no room for a lattice.
+    pub(super) fn regions(
+        &self,
+        shape: &Arc<Shape>,
+        keep: &[Mesh],
+        voxel: f64,
+        opts: &Options,
+        progress: &Progress,
+    ) -> Result<(f64, f64, MeshingStats)> {
+        let solid = |infill| FillSolid::<crate::tpms::Lattice> {
+            shape: shape.clone(),
+            skin: self.skin,
+            blend: self.blend,
+            infill,
+        };
+        let route = Route::choose(&solid(Infill::Full), voxel, opts);
+        let (whole, mut meshing) = {
+            let _p = progress.stage("measuring the part");
+            pipeline::solid_volume(&solid(Infill::Full), voxel, route)?
+        };
+        let base = if self.skin == 0.0 && keep.is_empty() {
+            0.0
+        } else {
+            let _p = progress.stage("measuring the skin");
+            let (v, m) = pipeline::solid_volume(&solid(Infill::Empty), voxel, route)?;
+            meshing.add(&m);
+            v
+        };
+        let fill = whole - base;
+        if fill.is_nan() || fill <= 1e-6 * whole {
+            return Err(Error::invalid(format!(
+                "a skin of {} mm leaves no room for a lattice in {}: it is thicker than half the part",
+                self.skin, self.part_name
+            )));
+        }
+        Ok((whole, base, meshing))
+    }
+
     /// Refuses a drain hole wider than half the part's smallest extent.
     pub(super) fn check_drain(&self, part: &Mesh, d: f64) -> Result<()> {
         let b = part.bounds().expect("a part has triangles");
@@ -398,35 +450,9 @@ impl FillJob {
                 blend: self.blend,
                 infill,
             };
-            // The part's distance grid is held throughout: the meshing gets the rest of the budget.
-            let opts = &Options {
-                memory: Some(
-                    opts.memory
-                        .unwrap_or(pipeline::DEFAULT_MEMORY)
-                        .saturating_sub(shape.memory_bytes()),
-                ),
-                ..*opts
-            };
-            let part_route = Route::choose(&solid(Infill::Full), voxel, opts);
-            let (whole, mut meshing) = {
-                let _p = progress.stage("measuring the part");
-                pipeline::solid_volume(&solid(Infill::Full), voxel, part_route)?
-            };
-            let base = if self.skin == 0.0 && keep.is_empty() {
-                0.0
-            } else {
-                let _p = progress.stage("measuring the skin");
-                let (v, m) = pipeline::solid_volume(&solid(Infill::Empty), voxel, part_route)?;
-                meshing.add(&m);
-                v
-            };
+            let opts = &self.beside(&shape, opts);
+            let (whole, base, mut meshing) = self.regions(&shape, keep, voxel, opts, progress)?;
             let fill = whole - base;
-            if fill.is_nan() || fill <= 1e-6 * whole {
-                return Err(Error::invalid(format!(
-                    "a skin of {} mm leaves no room for a lattice in {}: it is thicker than half the part",
-                    self.skin, self.part_name
-                )));
-            }
             let family = FillFamily {
                 lattice,
                 part: solid(Infill::Empty),

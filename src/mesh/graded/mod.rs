@@ -145,7 +145,9 @@ impl Grading {
             }
         }
         if lo.0 > hi.0 {
-            return Err(Error::invalid("the part holds no lattice to grade"));
+            return Err(Error::invalid(
+                "no point of the part holds lattice: the skin leaves no room for one",
+            ));
         }
         for (v, p) in [lo, hi] {
             if !self.clamp && (v < feasible.min || v > feasible.max) {
