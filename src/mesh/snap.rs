@@ -133,17 +133,9 @@ pub fn unfold(mesh: &mut KeyedMesh, spec: &GridSpec) -> u64 {
             })
             .flat_map_iter(|t| t.to_vec())
             .collect();
-        let mut changed = false;
-        for v in bad {
-            let o = original(mesh, v);
-            let p = &mut mesh.positions[v as usize];
-            if *p != o {
-                *p = o;
-                restored += 1;
-                changed = true;
-            }
-        }
-        if !changed {
+        let moved = restore(mesh, spec, &bad);
+        restored += moved;
+        if moved == 0 {
             break;
         }
     }
@@ -206,21 +198,27 @@ fn untangle_rims(mesh: &mut KeyedMesh, clip: &Aabb, spec: &GridSpec) -> u64 {
                 out
             })
             .collect();
-        let mut changed = false;
-        for v in bad {
-            let o = position(spec, mesh.keys[v as usize].voxel, mesh.offsets[v as usize]);
-            let p = &mut mesh.positions[v as usize];
-            if *p != o {
-                *p = o;
-                restored += 1;
-                changed = true;
-            }
-        }
-        if !changed {
+        let moved = restore(mesh, spec, &bad);
+        restored += moved;
+        if moved == 0 {
             break;
         }
     }
     restored
+}
+
+/// Returns the vertices `bad` to OpenVDB's positions; how many moved.
+fn restore(mesh: &mut KeyedMesh, spec: &GridSpec, bad: &[u32]) -> u64 {
+    let mut moved = 0;
+    for &v in bad {
+        let o = position(spec, mesh.keys[v as usize].voxel, mesh.offsets[v as usize]);
+        let p = &mut mesh.positions[v as usize];
+        if *p != o {
+            *p = o;
+            moved += 1;
+        }
+    }
+    moved
 }
 
 fn snap_vertex(
