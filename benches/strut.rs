@@ -7,7 +7,7 @@
 //! memory of N×N×N BCC cells (see [`scale`]).
 
 use latvox::field::Domain;
-use latvox::io::sink::MeshFile;
+use latvox::mesh::output::MeshFile;
 use latvox::mesh::pipeline::Options;
 use latvox::progress::Progress;
 use latvox::strut::{Sizing, StrutJob, UnitCell};

@@ -52,6 +52,7 @@ std::unique_ptr<VdbGrid> vdb_grid_from_mesh(rust::Slice<const float> positions,
                                             float interior_width);
 
 // vdb_probe.cc: the grid's values at world points (xyz triples), trilinear between voxels.
+std::unique_ptr<VdbGrid> vdb_csg(const VdbGrid& a, const VdbGrid& b, bool difference);
 void vdb_probe(const VdbGrid& grid, rust::Slice<const double> points, rust::Slice<float> values);
 
 // vdb_filter.cc: the level set rebuilt as a signed distance `half_width` voxels each side of

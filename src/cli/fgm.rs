@@ -118,7 +118,7 @@ pub struct FgmArgs {
     #[arg(long, value_name = "#RGB,#RGB,…")]
     pub palette: Option<String>,
     /// The part's mesh: .ply (vertex colours), .3mf (composite materials per vertex), .stl,
-    /// .obj or .off [default: fgm.ply]; with --2d, the signed distance image, .csv [default:
+    /// .obj or .off, or its level set alone, .vdb [default: fgm.ply]; with --2d, the signed distance image, .csv [default:
     /// fgm.csv].
     #[arg(long, short = 'o', value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -334,29 +334,27 @@ impl FgmArgs {
     }
 }
 
-/// Writes `mesh` with its composition: vertex colours in PLY, geometry alone otherwise.
+/// Writes `mesh` with its composition: vertex colours in PLY, composite materials in 3MF,
+/// geometry alone in the other formats (`.vdb`: the level set at the job's voxels).
 fn write_mesh(
     path: &Path,
     fgm: &latvox::fgm::Fgm,
     job: &FgmJob,
     palette: &[[u8; 3]],
 ) -> Result<()> {
-    let format = latvox::io::Format::from_path(path).ok_or_else(|| {
-        Error::invalid(format!(
-            "{}: the mesh's extension names no format (.ply, .stl, .obj, .off, .3mf)",
-            path.display()
-        ))
-    })?;
-    latvox::io::atomic::write_atomic(path, |w| match format {
-        latvox::io::Format::Ply => {
+    use latvox::io::Format;
+    use latvox::mesh::output::{MeshFile, Written};
+    let file = MeshFile::new(path, false)?.with_voxel(job.voxel);
+    match file.written {
+        Written::Mesh(Format::Ply) => latvox::io::atomic::write_atomic(path, |w| {
             let colours: Vec<[u8; 3]> = fgm
                 .vertex_fractions(&job.features)
                 .iter()
                 .map(|f| latvox::fgm::job::mix(f, palette))
                 .collect();
             latvox::io::ply::write_coloured(&fgm.mesh, &colours, w)
-        }
-        latvox::io::Format::ThreeMf => {
+        }),
+        Written::Mesh(Format::ThreeMf) => latvox::io::atomic::write_atomic(path, |w| {
             let fractions = fgm.vertex_fractions(&job.features);
             let c = latvox::io::threemf::Composites {
                 names: &fgm.composition.materials,
@@ -364,9 +362,9 @@ fn write_mesh(
                 fractions: &fractions,
             };
             latvox::io::threemf::write_composites(&fgm.mesh, &c, w)
-        }
-        _ => latvox::io::write(&fgm.mesh, format, false, w),
-    })
+        }),
+        _ => file.save(&fgm.mesh),
+    }
 }
 
 impl FgmArgs {
@@ -555,6 +553,8 @@ pub fn execute(a: &FgmArgs, progress: &Progress) -> Result<FgmReport> {
         ));
     }
     latvox::io::atomic::check_writable(&output)?;
+    // The output's extension is refused before the work, not after.
+    latvox::mesh::output::MeshFile::new(&output, false)?;
     for p in a.vdb.iter().chain(&a.preview) {
         latvox::io::atomic::check_writable(p)?;
     }

@@ -10,8 +10,9 @@ use clap::Args;
 use latvox::check::verify::Verify;
 use latvox::field::density::DensityField;
 use latvox::field::Domain;
-use latvox::io::sink::{MeshFile, MeshSink};
+use latvox::io::sink::MeshSink;
 use latvox::mesh::graded::{Grading, GradingReport};
+use latvox::mesh::output::MeshFile;
 use latvox::mesh::pipeline::Options;
 use latvox::mesh::report::PartReport;
 use latvox::{Error, Result};
@@ -135,11 +136,12 @@ pub struct MeshArgs {
     pub adaptivity: f64,
     /// Output mesh, in the format its extension names: .stl (binary, ASCII with --ascii) or
     /// .3mf, streamed to the file as it is made; .obj, .off or .ply (binary, ASCII with
-    /// --ascii), written once the part is whole.
+    /// --ascii), written once the part is whole; .vdb, the part's level set at its voxels
+    /// (OpenVDB, a grid named sdf).
     #[arg(
         long,
         short = 'o',
-        value_name = "FILE.stl|.3mf|.obj|.off|.ply",
+        value_name = "FILE.stl|.3mf|.obj|.off|.ply|.vdb",
         default_value = "lattice.stl"
     )]
     pub output: PathBuf,
@@ -210,8 +212,10 @@ impl MeshArgs {
         latvox::io::atomic::check_writable(&self.output)?;
         let mut sink = MeshFile::new(&self.output, self.ascii)?.sink()?;
         let mut report = job(&mut sink)?;
+        let written = part(&mut report);
+        sink.set_voxel(written.meshing.voxel_size);
         sink.commit()?;
-        part(&mut report).output = Some(self.output.display().to_string());
+        written.output = Some(self.output.display().to_string());
         Ok(report)
     }
 

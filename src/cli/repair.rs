@@ -4,7 +4,7 @@
 use super::check::{print_header, print_summary};
 use super::out::outln;
 use clap::Args;
-use latvox::io::sink::MeshFile;
+use latvox::mesh::output::MeshFile;
 use latvox::progress::Progress;
 use latvox::repair::{repair_file, FileRepairReport, RepairOptions};
 use latvox::Result;
@@ -76,7 +76,7 @@ impl RepairArgs {
 /// batch` to record.
 pub fn execute(a: &RepairArgs, progress: &Progress) -> Result<FileRepairReport> {
     latvox::io::atomic::check_writable(&a.output)?;
-    let output = MeshFile::new(&a.output, a.ascii)?;
+    let output = MeshFile::mesh(&a.output, a.ascii)?;
     if let Some(r) = &a.common.report {
         latvox::io::atomic::check_writable(r)?;
     }

@@ -80,7 +80,8 @@ pub struct TopoArgs {
     /// Max deviation of the CAD curves from the boundary, mm (default: half a refined pixel).
     #[arg(long, value_name = "MM")]
     pub tolerance: Option<f64>,
-    /// Output mesh, in the format its extension names: .stl, .obj, .off, .ply or .3mf.
+    /// Output, in the format its extension names: a mesh (.stl, .obj, .off, .ply, .3mf) or the
+    /// part's level set (.vdb, OpenVDB, a grid named sdf).
     #[arg(long, short = 'o', value_name = "FILE.stl", default_value = "part.stl")]
     pub output: PathBuf,
     /// Write ASCII STL (or ASCII PLY).

@@ -55,6 +55,7 @@ pub(crate) mod ffi {
             exterior_width: f32,
             interior_width: f32,
         ) -> Result<UniquePtr<VdbGrid>>;
+        fn vdb_csg(a: &VdbGrid, b: &VdbGrid, difference: bool) -> Result<UniquePtr<VdbGrid>>;
         fn vdb_probe(grid: &VdbGrid, points: &[f64], values: &mut [f32]);
         fn vdb_smoothed(
             grid: &VdbGrid,

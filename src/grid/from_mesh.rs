@@ -50,3 +50,64 @@ impl Grid {
         })
     }
 }
+
+impl Grid {
+    /// The level set of the solid a closed, outward mesh bounds, at `voxel` mm, its enclosed
+    /// voids kept: OpenVDB's meshToLevelSet finds the sign by flood-filling the outside, so a
+    /// void no path from outside reaches would be filled. The shells facing in (negative
+    /// volume: the voids' walls) are made a level set of their own and taken away
+    /// (csgDifference), and the shells facing out that lie inside a void (islands) are added
+    /// back (csgUnion). A void inside an island inside a void is filled.
+    pub fn of_solid(mesh: &Mesh, voxel: f64, half_width: f64) -> Result<Grid> {
+        use crate::mesh::topology::{Shells, Topology};
+        let shells = Shells::new(mesh, &Topology::new(mesh));
+        let corner = |i: u32| {
+            let i = 3 * i as usize;
+            [0, 1, 2].map(|a| mesh.positions[i + a] as f64)
+        };
+        let facets = |f: u32| &mesh.indices[3 * f as usize..3 * f as usize + 3];
+        let volume = |s: &[u32]| -> f64 {
+            s.iter()
+                .map(|&f| {
+                    let t = facets(f);
+                    crate::mesh::signed_volume(corner(t[0]), corner(t[1]), corner(t[2]))
+                })
+                .sum()
+        };
+        let (walls, solids): (Vec<&Vec<u32>>, Vec<&Vec<u32>>) =
+            shells.members.iter().partition(|s| volume(s) < 0.0);
+        if walls.is_empty() {
+            return Self::from_mesh(mesh, voxel, half_width);
+        }
+        let part = |of: &[&Vec<u32>]| Mesh {
+            positions: mesh.positions.clone(),
+            indices: of
+                .iter()
+                .flat_map(|s| s.iter().flat_map(|&f| facets(f).iter().copied()))
+                .collect(),
+        };
+        let voids = Self::from_mesh(&part(&walls), voxel, half_width)?;
+        // A shell's point furthest along x lies outside every void the shell encloses.
+        let (islands, outer): (Vec<&Vec<u32>>, Vec<&Vec<u32>>) = solids.iter().partition(|s| {
+            let p = s
+                .iter()
+                .flat_map(|&f| facets(f).iter().map(|&i| corner(i)))
+                .fold(
+                    [f64::NEG_INFINITY; 3],
+                    |m, p| if p[0] > m[0] { p } else { m },
+                );
+            voids.value_at(p) < 0.0
+        });
+        let mut grid = Self::from_mesh(&part(&outer), voxel, half_width)?;
+        grid.inner = ffi::vdb_csg(&grid.inner, &voids.inner, true)
+            .backend("taking the voids from the level set (OpenVDB csgDifference)")?
+            .into();
+        if !islands.is_empty() {
+            let islands = Self::from_mesh(&part(&islands), voxel, half_width)?;
+            grid.inner = ffi::vdb_csg(&grid.inner, &islands.inner, false)
+                .backend("adding the islands to the level set (OpenVDB csgUnion)")?
+                .into();
+        }
+        Ok(grid)
+    }
+}

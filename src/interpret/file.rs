@@ -8,7 +8,7 @@ use super::{images, CleanOptions, Density};
 use crate::error::{Error, Result};
 use crate::grid::Smoothing;
 use crate::io::atomic::{check_writable, write_atomic};
-use crate::io::sink::MeshFile;
+use crate::mesh::output::MeshFile;
 use crate::progress::Progress;
 use std::path::{Path, PathBuf};
 
@@ -177,7 +177,7 @@ pub fn interpret_file(
     }
     let mesh_file = MeshFile::new(&files.mesh, files.ascii)?;
     let r = job::run(&d, &job, progress)?;
-    mesh_file.save(&r.mesh)?;
+    mesh_file.with_voxel(r.cleaned.field.h).save(&r.mesh)?;
     write_curves(&r, files)?;
     if let Some(p) = &files.cleaned {
         write_cleaned(&r, p)?;

@@ -6,14 +6,13 @@
 //! is killed, leaves no partial file. [`MeshCollector`] gathers the triangles into an indexed
 //! [`Mesh`] instead (welding bit-identical vertices), for callers that want the mesh itself.
 //! [`Measures`] accumulates what every sink's caller reports: triangle count, enclosed volume,
-//! area and bounds of the triangles exactly as they are written. [`MeshFile`] is an output file
-//! in the format its extension names, and gives the sink that writes it.
+//! area and bounds of the triangles exactly as they are written. `mesh::output` chooses among
+//! them by the output's extension.
 
 use crate::error::{Error, Result};
 use crate::field::Aabb;
 use crate::io::stl::StlFormat;
 use crate::io::weld::ExactIndex;
-use crate::io::Format;
 use crate::mesh::Mesh;
 use rayon::prelude::*;
 use std::io::Write;
@@ -419,109 +418,5 @@ impl MeshSink for ThreeMfSink {
 
     fn finish(&mut self) -> Result<()> {
         Ok(())
-    }
-}
-
-/// An output mesh file: its path, and the format its extension names. [`MeshFile::new`] is the
-/// one place an output's format is chosen.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct MeshFile {
-    /// Where the file goes.
-    pub path: PathBuf,
-    /// The format its extension names.
-    pub format: Format,
-    /// ASCII STL or ASCII PLY (binary otherwise; OBJ and OFF are text, 3MF a zip package).
-    pub ascii: bool,
-}
-
-impl MeshFile {
-    /// `path` in the format its extension names (case-insensitive: `.stl`, `.obj`, `.off`,
-    /// `.ply`, `.3mf`). Any other extension is refused, naming the path and those it could be.
-    pub fn new(path: &Path, ascii: bool) -> Result<MeshFile> {
-        let format = Format::from_path(path).ok_or_else(|| {
-            Error::invalid(format!(
-                "{}: unknown mesh extension (use .stl, .obj, .off, .ply or .3mf)",
-                path.display()
-            ))
-        })?;
-        Ok(MeshFile {
-            path: path.to_path_buf(),
-            format,
-            ascii,
-        })
-    }
-
-    /// A sink into the file; the file appears, whole, on [`FileSink::commit`].
-    pub fn sink(&self) -> Result<FileSink> {
-        let stl = if self.ascii {
-            StlFormat::Ascii
-        } else {
-            StlFormat::Binary
-        };
-        Ok(match self.format {
-            Format::Stl => FileSink::Stl(StlSink::create(&self.path, stl)?),
-            Format::ThreeMf => FileSink::ThreeMf(ThreeMfSink::create(&self.path)?),
-            Format::Obj | Format::Off | Format::Ply => FileSink::Indexed {
-                file: self.clone(),
-                collector: MeshCollector::default(),
-            },
-        })
-    }
-
-    /// Writes `mesh` to the file atomically, its vertices indexed as they are.
-    pub fn save(&self, mesh: &Mesh) -> Result<()> {
-        crate::io::atomic::write_atomic(&self.path, |w| {
-            crate::io::write(mesh, self.format, self.ascii, w)
-        })
-    }
-}
-
-/// A sink into a [`MeshFile`]: STL and 3MF stream to a temporary file as the triangles come;
-/// OBJ, OFF and PLY, which list each vertex once, gather the triangles (welding bit-identical
-/// corners, as [`MeshCollector`] does) and write them at [`FileSink::commit`].
-pub enum FileSink {
-    /// Binary or ASCII STL, streamed.
-    Stl(StlSink),
-    /// 3MF, streamed.
-    ThreeMf(ThreeMfSink),
-    /// OBJ, OFF or PLY: gathered, written at commit.
-    Indexed {
-        /// The file to write.
-        file: MeshFile,
-        /// The triangles gathered, welded.
-        collector: MeshCollector,
-    },
-}
-
-impl FileSink {
-    /// Moves the finished file into place.
-    pub fn commit(self) -> Result<()> {
-        match self {
-            FileSink::Stl(s) => s.commit(),
-            FileSink::ThreeMf(s) => s.commit(),
-            FileSink::Indexed { file, collector } => file.save(&collector.mesh),
-        }
-    }
-
-    fn inner(&mut self) -> &mut dyn MeshSink {
-        match self {
-            FileSink::Stl(s) => s,
-            FileSink::ThreeMf(s) => s,
-            FileSink::Indexed { collector, .. } => collector,
-        }
-    }
-}
-
-impl MeshSink for FileSink {
-    fn begin(&mut self, triangles: Option<u64>) -> Result<()> {
-        self.inner().begin(triangles)
-    }
-
-    fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
-        self.inner().triangles(batch)
-    }
-
-    fn finish(&mut self) -> Result<()> {
-        self.inner().finish()
     }
 }

@@ -6,7 +6,7 @@
 //! fragments a box cuts loose, and [`pipeline`] puts them together: any clipped field to a
 //! verified mesh at its target density, streamed to a sink, at the resolution [`resolution`]
 //! finds it needs,
-//! reported the same way for every capability ([`report`]); [`graded`] meets a density that
+//! reported the same way for every capability ([`report`]) and written where [`output`] says; [`graded`] meets a density that
 //! varies through the part, cell by cell ([`cells`] measures them). [`topology`] and [`triangulate`]
 //! serve the checks and the readers.
 
@@ -15,6 +15,7 @@ pub mod extract;
 pub mod graded;
 mod indexed;
 pub mod instance;
+pub mod output;
 pub mod pieces;
 pub mod pipeline;
 pub mod report;

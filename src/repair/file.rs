@@ -4,8 +4,8 @@
 use super::{repair, RepairOptions, RepairReport};
 use crate::check::{check, read_file, CheckOptions, CheckReport, Defects, Verdict};
 use crate::error::{Error, Result};
-use crate::io::sink::MeshFile;
 use crate::io::{Format, ReadOptions, Reading};
+use crate::mesh::output::MeshFile;
 use crate::progress::Progress;
 use std::path::Path;
 
