@@ -7,10 +7,11 @@ use std::path::Path;
 /// The C++ headers: one per library, and what the OpenVDB units share.
 const HEADERS: [&str; 3] = ["cpp/vdb.h", "cpp/vdb_internal.h", "cpp/cgal.h"];
 /// The translation units behind `cpp/vdb.h`.
-const VDB_UNITS: [&str; 7] = [
+const VDB_UNITS: [&str; 8] = [
     "cpp/vdb_grid.cc",
     "cpp/vdb_from_mesh.cc",
     "cpp/vdb_csg.cc",
+    "cpp/vdb_read.cc",
     "cpp/vdb_probe.cc",
     "cpp/vdb_filter.cc",
     "cpp/vdb_mesh.cc",

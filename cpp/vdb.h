@@ -27,6 +27,7 @@ struct VdbFile {
 };
 
 struct Extraction;
+struct DenseValues;
 enum class SmoothingMode : uint8_t;
 
 // vdb_grid.cc: the grid and what it holds.
@@ -75,5 +76,6 @@ std::unique_ptr<VdbGrid> vdb_values_from_leaves(double voxel_size, rust::Slice<c
 std::unique_ptr<VdbFile> vdb_file_new();
 void vdb_file_add(VdbFile& file, const VdbGrid& grid, rust::Str name);
 void vdb_file_write(const VdbFile& file, rust::Str path);
+void vdb_read_dense(rust::Str path, uint64_t max_values, DenseValues& out);
 
 }  // namespace latvox

@@ -412,6 +412,54 @@ fn partial_cells_odd_origins_and_sampled_fields() {
         // Trilinear between samples 20/3 mm apart along y.
         &|p| 0.25 + 0.05 * (p[1] / (20.0 / 3.0)).clamp(0.0, 3.0),
     );
+    // A .vdb made by OpenVDB's Python module: a grid of 0.8 mm voxels whose index (0, 0, 0) sits
+    // at -1.2 mm, holding 0.15 + 0.01·z at each voxel's centre.
+    let vdb = dir.path().join("field.vdb");
+    write_vdb_field(&vdb, "g = vdb.FloatGrid(); g.name = 'density'");
+    check_graded(
+        &[
+            "tpms",
+            "--density-field",
+            vdb.to_str().unwrap(),
+            "--cells",
+            "3,3,4",
+            "--cell-size",
+            "5",
+            "-r",
+            "16",
+        ],
+        [0.0; 3],
+        [5.0; 3],
+        [15.0, 15.0, 20.0],
+        &|p| 0.15 + 0.01 * p[2],
+    );
+}
+
+/// Writes a `.vdb` with OpenVDB's Python module: the grid `make` names `g` (a float grid gets
+/// 0.15 + 0.01·z over 20 × 20 × 30 voxels of 0.8 mm from -1.2 mm).
+fn write_vdb_field(path: &Path, make: &str) {
+    let script = format!(
+        "import sys, numpy as np, pyopenvdb as vdb
+{make}
+t = vdb.createLinearTransform(voxelSize=0.8)
+t.translate((-1.2, -1.2, -1.2))
+if isinstance(g, vdb.FloatGrid):
+    a = np.zeros((20, 20, 30), dtype=np.float32)
+    for k in range(30):
+        a[:, :, k] = 0.15 + 0.01 * (0.8 * k - 1.2)
+    g.copyFromArray(a, ijk=(0, 0, 0))
+else:
+    g.fill((0, 0, 0), (3, 3, 3), (1, 0, 0))
+g.transform = t
+vdb.write(sys.argv[1], grids=[g])
+"
+    );
+    let o = std::process::Command::new("/usr/bin/python3")
+        .args(["-c", &script])
+        .arg(path)
+        .output()
+        .expect("/usr/bin/python3 with python3-openvdb");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
 /// Settings drawn at random (seeded): type, structure, axis, the grade's ends within the type's
@@ -474,7 +522,18 @@ fn bad_fields_are_refused() {
     latvox::io::npy::write(&mut bytes, &[4], &[0.2; 4]).unwrap();
     std::fs::write(&flat, bytes).unwrap();
     let flat = flat.to_str().unwrap().to_string();
-    let cases: [(&[&str], &str); 8] = [
+    let vectors = dir.path().join("vectors.vdb");
+    write_vdb_field(&vectors, "g = vdb.Vec3SGrid(); g.name = 'velocity'");
+    let vectors = vectors.to_str().unwrap().to_string();
+    let cases: [(&[&str], &str); 10] = [
+        (
+            &["--density-field", "missing.vdb"],
+            "cannot read missing.vdb",
+        ),
+        (
+            &["--density-field", &vectors],
+            "no float grid (grids: velocity)",
+        ),
         (&["--density-field", "0.2 + * z"], "column 7"),
         (&["--density-field", "0.2 + 0.1*sin(z"], "column 16"),
         (&["--density-field", "0.2 + q"], "unknown name 'q'"),

@@ -26,9 +26,14 @@ pub struct GradeArgs {
     #[arg(long, value_name = "AXIS:A:B", conflicts_with = "density_field")]
     pub density_grade: Option<String>,
     /// Grade the density by a field: an expression in x, y, z (mm; as "0.15 + 0.1*sin(PI*x/20)";
-    /// for fill also d, the depth below the skin) or a .npy array of shape (NX, NY, NZ) sampled
-    /// over the box, corners on its corners.
-    #[arg(long, value_name = "EXPR|FILE.npy", allow_hyphen_values = true)]
+    /// for fill also d, the depth below the skin), a .npy array of shape (NX, NY, NZ) sampled
+    /// over the box, corners on its corners, or a .vdb's float grid (named density, or the
+    /// first) in the part's coordinates, read between its voxels' centres.
+    #[arg(
+        long,
+        value_name = "EXPR|FILE.npy|FILE.vdb",
+        allow_hyphen_values = true
+    )]
     pub density_field: Option<String>,
     /// Hold a density field to the type's feasible range instead of refusing it (reported).
     #[arg(long)]
@@ -40,6 +45,10 @@ impl GradeArgs {
     pub fn grading(&self, bounds: &latvox::field::Aabb) -> Result<Option<Grading>> {
         let field = match (&self.density_grade, &self.density_field) {
             (Some(g), _) => DensityField::grade(g, bounds)?,
+            (None, Some(f)) if f.to_ascii_lowercase().ends_with(".vdb") => {
+                let (nodes, name) = latvox::grid::read_values(std::path::Path::new(f))?;
+                DensityField::nodes(nodes, format!("grid '{name}' of {f}"))
+            }
             (None, Some(f)) => DensityField::parse(f, bounds)?,
             (None, None) if self.clamp => {
                 return Err(Error::invalid(

@@ -17,6 +17,21 @@ pub(crate) mod ffi {
         quads: Vec<u32>,
     }
 
+    /// A float grid of a `.vdb` file copied densely over its active voxels' bounding box.
+    #[derive(Default)]
+    struct DenseValues {
+        /// The grid's name.
+        name: String,
+        /// World position of the box's first voxel (its centre), mm.
+        origin: Vec<f64>,
+        /// Voxel size, mm (the same along each axis).
+        step: f64,
+        /// Voxels along x, y, z.
+        dims: Vec<u64>,
+        /// The values, z fastest, then y, then x.
+        values: Vec<f32>,
+    }
+
     /// One pass of OpenVDB's `LevelSetFilter`.
     #[repr(u8)]
     enum SmoothingMode {
@@ -84,6 +99,7 @@ pub(crate) mod ffi {
             values: &[f32],
         ) -> Result<UniquePtr<VdbGrid>>;
         fn vdb_file_new() -> UniquePtr<VdbFile>;
+        fn vdb_read_dense(path: &str, max_values: u64, out: &mut DenseValues) -> Result<()>;
         fn vdb_file_add(file: Pin<&mut VdbFile>, grid: &VdbGrid, name: &str);
         fn vdb_file_write(file: &VdbFile, path: &str) -> Result<()>;
     }

@@ -1,6 +1,7 @@
 //! Density fields: the volume fraction a graded part should have at each point — a linear grade
 //! along an axis, an expression in `x, y, z` (and `d`, the distance to a filled part's skin), or
-//! a sampled `.npy` array spanning the part's box, read trilinearly.
+//! a sampled `.npy` array spanning the part's box or a grid of a `.vdb` in the part's own
+//! coordinates, read trilinearly.
 //!
 //! Expressions are compiled and evaluated by the `exmex` crate; they are read first by a small
 //! recursive-descent reader here, which points at the column of a syntax error, refuses names
@@ -135,6 +136,15 @@ impl DensityField {
             }),
             source: format!("samples {}", path.display()),
         })
+    }
+
+    /// Values at nodes placed in the part's coordinates (a grid read from a `.vdb`), read
+    /// trilinearly and held at the outer nodes beyond them.
+    pub fn nodes(nodes: Nodes, source: String) -> DensityField {
+        DensityField {
+            kind: Kind::Samples(nodes),
+            source,
+        }
     }
 
     /// Whether the field reads the distance to a part's skin (`d`).

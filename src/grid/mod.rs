@@ -17,12 +17,14 @@ use crate::field::{Aabb, Vec3};
 
 mod from_mesh;
 mod probe;
+mod read;
 mod sample;
 mod smooth;
 mod to_mesh;
 mod values;
 mod write;
 
+pub use read::read_values;
 pub use write::write_vdb_grids;
 
 pub use smooth::Smoothing;
