@@ -52,6 +52,7 @@ fn one(config: &str) {
             field: Arc::new(DensityField::grade("z:0.1:0.4", &domain.bounds()).unwrap()),
             clamp: false,
         }),
+        blend: None,
     };
     let t = Instant::now();
     let mut sink = DiscardedStl::default();

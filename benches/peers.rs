@@ -216,6 +216,7 @@ fn child(a: &[String]) {
                 memory: None,
                 keep_fragments: false,
                 grading: None,
+                blend: None,
             };
             let mut sink =
                 latvox::io::sink::StlSink::create(&stl, latvox::io::StlFormat::Binary).unwrap();

@@ -25,6 +25,7 @@ fn every_type_and_structure_hits_its_target_within_0_002() {
                     memory: None,
                     keep_fragments: false,
                     grading: None,
+                    blend: None,
                 };
                 let (mesh, r) = job.run(&latvox::progress::Progress::hidden()).unwrap();
                 assert!(

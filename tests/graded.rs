@@ -156,6 +156,87 @@ fn a_gyroid_graded_along_z_meets_the_grade_in_every_cell() {
     assert!(worst < 0.005, "{worst}");
 }
 
+/// The must-show blend: a gyroid net turning into a diamond net along x at 30 %, the weight
+/// 0 below x = 5 and 1 above x = 25 (x:-0.25:1.25 held to [0, 1]): every whole cell at 30 %
+/// (±0.005, the field being flat), one piece, clean by CGAL; the surface in the first cell lies
+/// on one level of the gyroid's formula and in the last on one of the diamond's (the test's
+/// own formulas, within 0.01; each end far from the other type's level set). And a Schwarz P sheet blended
+/// into a gyroid sheet by an expression, its density graded along x.
+#[test]
+fn a_gyroid_blended_into_a_diamond_holds_the_density_in_every_cell() {
+    let args = [
+        "tpms",
+        "--type",
+        "gyroid",
+        "--blend-to",
+        "d",
+        "--blend-field",
+        "x:-0.25:1.25",
+        "--density",
+        "0.3",
+        "--cells",
+        "6,2,2",
+        "--cell-size",
+        "5",
+        "-r",
+        "24",
+    ];
+    check_graded(&args, [0.0; 3], [5.0; 3], [30.0, 10.0, 10.0], &|_| 0.3);
+    let dir = tempdir();
+    let mut all = args.to_vec();
+    all.extend(["-q", "-o", "blend.stl"]);
+    ok(&all, dir.path());
+    let tris = read_stl(&dir.path().join("blend.stl"));
+    // Away from the box's faces (more than a voxel, 0.21 mm), where the surface is the
+    // lattice's own.
+    let inner =
+        |p: &[f64; 3]| (1..3).all(|a| p[a] > 0.25 && p[a] < 9.75) && p[0] > 0.25 && p[0] < 29.75;
+    let spread = |name: &str, keep: &dyn Fn(f64) -> bool| {
+        let values: Vec<f64> = tris
+            .iter()
+            .flatten()
+            .filter(|p| inner(p) && keep(p[0]))
+            .map(|p| tpms(name, *p, 5.0).0)
+            .collect();
+        assert!(values.len() > 1000, "{name}: {} vertices", values.len());
+        let (lo, hi) = values
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+        hi - lo
+    };
+    let gyroid_end = |x: f64| x < 4.5;
+    let diamond_end = |x: f64| x > 25.5;
+    assert!(spread("gyroid", &gyroid_end) < 0.01);
+    assert!(spread("d", &diamond_end) < 0.01);
+    assert!(spread("d", &gyroid_end) > 0.5);
+    assert!(spread("gyroid", &diamond_end) > 0.5);
+    check_graded(
+        &[
+            "tpms",
+            "--type",
+            "p",
+            "--structure",
+            "sheet",
+            "--blend-to",
+            "gyroid",
+            "--blend-field",
+            "0.5+0.5*sin(PI*z/15)",
+            "--density-grade",
+            "x:0.15:0.3",
+            "--cells",
+            "3",
+            "--cell-size",
+            "5",
+            "-r",
+            "16",
+        ],
+        [0.0; 3],
+        [5.0; 3],
+        [15.0; 3],
+        &|p| 0.15 + 0.15 * p[0] / 15.0,
+    );
+}
+
 /// The must-show strut part: a 6×6×6-cell BCC block graded 0.1 → 0.4 along z (the strut
 /// radius varies with the height).
 #[test]
@@ -525,7 +606,29 @@ fn bad_fields_are_refused() {
     let vectors = dir.path().join("vectors.vdb");
     write_vdb_field(&vectors, "g = vdb.Vec3SGrid(); g.name = 'velocity'");
     let vectors = vectors.to_str().unwrap().to_string();
-    let cases: [(&[&str], &str); 10] = [
+    let cases: [(&[&str], &str); 14] = [
+        (
+            &["--blend-to", "q", "--blend-field", "x:0:1"],
+            "unknown TPMS type 'q'",
+        ),
+        (&["--blend-to", "d"], "--blend-field"),
+        (
+            &["--blend-to", "d", "--blend-field", "0.5 + * x"],
+            "column 7",
+        ),
+        (
+            &[
+                "--type",
+                "p",
+                "--blend-to",
+                "d",
+                "--blend-field",
+                "x:0:1",
+                "--density",
+                "0.1",
+            ],
+            "p net blended to d (0.214",
+        ),
         (
             &["--density-field", "missing.vdb"],
             "cannot read missing.vdb",

@@ -87,6 +87,7 @@ fn tpms_mesh(surface: Surface, structure: Structure, cells: u32, resolution: u32
         memory: None,
         keep_fragments: false,
         grading: None,
+        blend: None,
     };
     job.run(&Progress::hidden()).unwrap().0
 }

@@ -45,11 +45,7 @@ impl GradeArgs {
     pub fn grading(&self, bounds: &latvox::field::Aabb) -> Result<Option<Grading>> {
         let field = match (&self.density_grade, &self.density_field) {
             (Some(g), _) => DensityField::grade(g, bounds)?,
-            (None, Some(f)) if f.to_ascii_lowercase().ends_with(".vdb") => {
-                let (nodes, name) = latvox::grid::read_values(std::path::Path::new(f))?;
-                DensityField::nodes(nodes, format!("grid '{name}' of {f}"))
-            }
-            (None, Some(f)) => DensityField::parse(f, bounds)?,
+            (None, Some(f)) => field(f, bounds)?,
             (None, None) if self.clamp => {
                 return Err(Error::invalid(
                     "--clamp holds a density field (--density-grade or --density-field) to the feasible range: give one",
@@ -62,6 +58,18 @@ impl GradeArgs {
             clamp: self.clamp,
         }))
     }
+}
+
+/// A field over `bounds`: an expression, a `.npy` array spanning it, or a `.vdb`'s grid.
+pub(crate) fn field(spec: &str, bounds: &latvox::field::Aabb) -> Result<DensityField> {
+    if spec.to_ascii_lowercase().ends_with(".vdb") {
+        let (nodes, name) = latvox::grid::read_values(std::path::Path::new(spec))?;
+        return Ok(DensityField::nodes(
+            nodes,
+            format!("grid '{name}' of {spec}"),
+        ));
+    }
+    DensityField::parse(spec, bounds)
 }
 
 /// The density line of a graded part's summary.

@@ -29,6 +29,8 @@ const PART_KEYS: &[(&str, &[&str])] = &[
             "density-grade",
             "density-field",
             "clamp",
+            "blend-to",
+            "blend-field",
             "allow-islands",
         ],
     ),

@@ -41,6 +41,9 @@ Examples:
   latvox tpms --type d --cells 8,8,2 --cell-size 5 \\
       --density-field '0.35 - 0.2*exp(-((x-20)^2 + (y-20)^2)/100)' -o rim.stl
 
+  # A gyroid net turning into a diamond net along x, 30 % in every cell through the blend
+  latvox tpms --type gyroid --blend-to d --blend-field x:0:1 --density 0.3 --cells 6,2,2 -o blend.stl
+
   # An F-RD net at 30 %: its first labyrinth falls apart there, its other one holds together
   latvox tpms --type frd --density 0.3 --side other --cells 3 -o frd.stl
 
@@ -74,6 +77,20 @@ pub struct TpmsArgs {
     /// A density that varies through the part.
     #[command(flatten)]
     pub grade: GradeArgs,
+    /// Blend the type into a second one (p, gyroid, d, …) by --blend-field: the solid where
+    /// (1 − w)·F/s + w·F₂/s₂ is below the level (s: each surface's RMS), each cell at its
+    /// density.
+    #[arg(long, value_name = "TYPE", value_parser = parse_surface, requires = "blend_field")]
+    pub blend_to: Option<Surface>,
+    /// The weight w of --blend-to at each point, held to [0, 1]: AXIS:A:B (linear along x, y or
+    /// z across the box, as x:0:1) or a field as --density-field takes.
+    #[arg(
+        long,
+        value_name = "AXIS:A:B|EXPR|FILE",
+        requires = "blend_to",
+        allow_hyphen_values = true
+    )]
+    pub blend_field: Option<String>,
     /// The box of cells.
     #[command(flatten)]
     pub domain: BoxArgs,
@@ -150,14 +167,29 @@ impl TpmsArgs {
             memory: o.memory,
             keep_fragments: o.keep_fragments,
             grading,
+            blend: match (self.blend_to, &self.blend_field) {
+                (Some(to), Some(f)) => Some(latvox::tpms::blend::Blend {
+                    to,
+                    weight: std::sync::Arc::new(if f.contains(':') {
+                        latvox::field::density::DensityField::grade(f, &bounds)?
+                    } else {
+                        super::lattice::field(f, &bounds)?
+                    }),
+                }),
+                _ => None,
+            },
         })
     }
 }
 
 fn print_tpms_summary(r: &TpmsReport) {
     let cells = r.cells.map(|x| human(x, 2)).join("×");
+    let blend = match &r.blend {
+        Some(b) => format!(" blended to {} by {}", b.to.name(), b.weight),
+        None => String::new(),
+    };
     outln!(
-        "{} {} · {cells} cells of {} mm · {} voxels/cell ({} mm)",
+        "{} {}{blend} · {cells} cells of {} mm · {} voxels/cell ({} mm)",
         r.surface.name(),
         r.structure.name(),
         triple(r.cell_size),

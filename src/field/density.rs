@@ -55,11 +55,7 @@ enum Kind {
 impl DensityField {
     /// `AXIS:A:B`: linear along x, y or z across `bounds` from `A` to `B`.
     pub fn grade(spec: &str, bounds: &Aabb) -> Result<DensityField> {
-        let bad = || {
-            Error::invalid(format!(
-                "--density-grade takes AXIS:A:B (as z:0.1:0.4), got '{spec}'"
-            ))
-        };
+        let bad = || Error::invalid(format!("a grade is AXIS:A:B (as z:0.1:0.4), got '{spec}'"));
         let parts: Vec<&str> = spec.split(':').collect();
         let [axis, a, b] = parts[..] else {
             return Err(bad());
@@ -136,6 +132,20 @@ impl DensityField {
             }),
             source: format!("samples {}", path.display()),
         })
+    }
+
+    /// The same density everywhere.
+    pub fn constant(density: f64) -> DensityField {
+        DensityField {
+            kind: Kind::Grade {
+                axis: 0,
+                a: density,
+                b: density,
+                lo: 0.0,
+                hi: 1.0,
+            },
+            source: format!("constant {density}"),
+        }
     }
 
     /// Values at nodes placed in the part's coordinates (a grid read from a `.vdb`), read

@@ -42,6 +42,20 @@ impl Nodes {
         }
     }
 
+    /// `value(p)` at nodes `step` apart over `bounds` grown by `margin`, a node on its lower
+    /// corner.
+    pub fn covering(
+        bounds: &super::Aabb,
+        step: Vec3,
+        margin: f64,
+        value: impl Fn(Vec3) -> f64 + Sync,
+    ) -> Nodes {
+        let origin = [0, 1, 2].map(|a| bounds.min[a] - (margin / step[a]).ceil() * step[a]);
+        let n =
+            [0, 1, 2].map(|a| ((bounds.max[a] + margin - origin[a]) / step[a]).ceil() as usize + 1);
+        Nodes::sample(origin, step, n, value)
+    }
+
     /// The value at `p`.
     #[inline(always)]
     pub fn at(&self, p: Vec3) -> f64 {

@@ -15,8 +15,7 @@ use crate::field::{Aabb, Vec3};
 use crate::io::sink::MeshSink;
 use crate::mesh::cells::CellVolumes;
 use crate::mesh::graded::{
-    self, Cells, Feasible, Graded, GradedFamily, GradedPart, Grading, LevelGrid, LevelMap,
-    Levelled, Run,
+    self, Cells, Feasible, Graded, GradedFamily, Grading, LevelGrid, LevelMap, Levelled, Run,
 };
 use crate::mesh::pipeline::Options;
 use crate::mesh::report::Timings;
@@ -47,19 +46,13 @@ impl<L: Levelled> Graded for FilledGraded<L> {
     where
         L: 'a;
 
-    fn level(&self, rho: f64) -> f64 {
+    fn level(&self, _p: Vec3, rho: f64) -> f64 {
         self.map.level(rho)
     }
 
     fn family<'a>(&'a self, levels: &'a LevelGrid) -> Self::Family<'a> {
         FillFamily {
-            lattice: GradedFamily {
-                part: GradedPart {
-                    lattice: self.lattice.clone(),
-                    levels,
-                    offset: 0.0,
-                },
-            },
+            lattice: GradedFamily::new(self.lattice.clone(), levels),
             part: FillSolid {
                 shape: self.shape.clone(),
                 skin: self.skin,

@@ -4,6 +4,7 @@
 //! the bias interpolated between them) and the lattice at a level that varies from point to
 //! point.
 
+use super::blend::BlendMapped;
 use super::calibrate::{self, Calibration};
 use super::job::TpmsJob;
 use super::{Lattice, Structure, Surface, TpmsField, TpmsReport};
@@ -25,6 +26,9 @@ pub struct Calibrated {
     pub middle: Calibration,
     /// Whether every calibration converged.
     pub converged: bool,
+    /// The meshing's bias at each knot of [`graded::knots`] over the range: the model's
+    /// fraction at the calibrated level less the knot's density.
+    pub bias: Vec<f64>,
 }
 
 impl Calibrated {
@@ -58,6 +62,7 @@ impl Calibrated {
             }),
             middle: middle.expect("at least one knot"),
             converged,
+            bias,
         })
     }
 }
@@ -166,46 +171,61 @@ impl TpmsJob {
         let bounds = self.domain.bounds();
         let cell = self.domain.cell;
         let range = calibrate::feasible(s, st);
+        // A blend must be feasible as either type.
+        let (range, what) = match &self.blend {
+            None => (range, format!("{} {}", s.name(), st.name())),
+            Some(b) => {
+                let other = calibrate::feasible(b.to, st);
+                (
+                    calibrate::FeasibleRange {
+                        min: range.min.max(other.min),
+                        max: range.max.min(other.max),
+                    },
+                    format!("{} {} blended to {}", s.name(), st.name(), b.to.name()),
+                )
+            }
+        };
         let feasible = Feasible {
             min: range.min,
             max: range.max,
-            what: format!("{} {}", s.name(), st.name()),
+            what,
             why: "the solid falls apart",
         };
         let targets = grading.check(&bounds, cell, &|_| Some(0.0), &feasible)?;
-        // Sheet walls are thinnest at the lowest density.
-        let lowest = calibrate::analytic_level(s, st, targets.built[0]);
-        let (resolution, warnings) = graded::raised(
-            self.resolution,
-            self.thin_walls(lowest),
-            self.auto_resolution,
-            "perforate",
-        )?;
+        // Sheet walls are thinnest at the lowest density (the thinner of the two types').
+        let thin = |surface: Surface| {
+            let job = TpmsJob {
+                surface,
+                ..self.clone()
+            };
+            job.thin_walls(calibrate::analytic_level(surface, st, targets.built[0]))
+        };
+        let thinnest = std::iter::once(s)
+            .chain(self.blend.as_ref().map(|b| b.to))
+            .filter_map(thin)
+            .max_by_key(|(r, _)| *r);
+        let (resolution, warnings) =
+            graded::raised(self.resolution, thinnest, self.auto_resolution, "perforate")?;
         let voxel = cell.iter().cloned().fold(f64::INFINITY, f64::min) / resolution as f64;
         let cal_start = Instant::now();
-        let calibrated = {
+        let (lo, hi) = (targets.built[0], targets.built[1]);
+        let calibrate =
+            |surface: Surface| Calibrated::build(surface, st, cell, voxel, self.adaptivity, lo, hi);
+        let (calibrated, other) = {
             let _p = progress.stage("calibrating the density → level map");
-            Calibrated::build(
-                s,
-                st,
-                cell,
-                voxel,
-                self.adaptivity,
-                targets.built[0],
-                targets.built[1],
-            )?
+            (
+                calibrate(s)?,
+                self.blend.as_ref().map(|b| calibrate(b.to)).transpose()?,
+            )
         };
         let calibrate_seconds = cal_start.elapsed().as_secs_f64();
-        let kind = Mapped {
-            lattice: Lattice {
-                surface: s,
-                structure: st,
-                level: calibrated.middle.level,
-                cell,
-                bounds,
-                phase: bounds.min,
-            },
-            map: calibrated.map,
+        let lattice = Lattice {
+            surface: s,
+            structure: st,
+            level: calibrated.middle.level,
+            cell,
+            bounds,
+            phase: bounds.min,
         };
         let opts = Options {
             adaptivity: self.adaptivity,
@@ -215,22 +235,35 @@ impl TpmsJob {
             memory: self.memory,
             keep_fragments: self.keep_fragments,
         };
-        let done = Run {
+        let run = Run {
             grading,
             targets,
             feasible,
             voxel,
             resolution,
             options: opts,
-            calibrated: calibrated.converged,
+            calibrated: calibrated.converged && other.as_ref().is_none_or(|o| o.converged),
             timings: Timings {
                 calibrate: calibrate_seconds,
                 ..Timings::default()
             },
             warnings,
             start,
-        }
-        .in_box(&kind, bounds, cell, progress, sink)?;
+        };
+        let done = match (&self.blend, &other) {
+            (Some(blend), Some(other)) => {
+                let margin = (crate::mesh::pipeline::HALF_WIDTH + 2.0) * voxel;
+                let kind = BlendMapped::new(lattice, blend, margin, (lo, hi), &calibrated, other);
+                run.in_box(&kind, bounds, cell, progress, sink)?
+            }
+            _ => {
+                let kind = Mapped {
+                    lattice,
+                    map: calibrated.map.clone(),
+                };
+                run.in_box(&kind, bounds, cell, progress, sink)?
+            }
+        };
         Ok(TpmsReport {
             surface: s,
             structure: st,
@@ -249,6 +282,10 @@ impl TpmsJob {
             cell_size: cell,
             cells: self.domain.counts(),
             grading: Some(done.grading),
+            blend: self.blend.as_ref().map(|b| super::blend::BlendReport {
+                to: b.to,
+                weight: b.weight.source.clone(),
+            }),
             part: done.part,
         })
     }

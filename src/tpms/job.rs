@@ -53,6 +53,8 @@ pub struct TpmsJob {
     pub keep_fragments: bool,
     /// A density that varies through the part (`density` is then not used).
     pub grading: Option<crate::mesh::graded::Grading>,
+    /// A second type blended in by a weight that varies through the part.
+    pub blend: Option<super::blend::Blend>,
 }
 
 /// The JSON report of a TPMS job.
@@ -88,6 +90,9 @@ pub struct TpmsReport {
     /// How a graded part met its density field, cell by cell.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub grading: Option<crate::mesh::graded::GradingReport>,
+    /// The type blended to and its weight field.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blend: Option<super::blend::BlendReport>,
     /// The part as written: density, mesh, checks, timings, warnings.
     #[serde(flatten)]
     pub part: PartReport,
@@ -105,7 +110,7 @@ impl TpmsJob {
     /// The part as an implicit solid, at the level the part is meshed at.
     pub fn model(&self) -> Result<crate::render::Model> {
         self.validate()?;
-        if self.grading.is_some() {
+        if self.grading.is_some() || self.blend.is_some() {
             return Err(Error::invalid(
                 "a graded part is drawn and sliced from its mesh: make it with -o part.stl, then render, view or slice part.stl",
             ));
@@ -161,6 +166,16 @@ impl TpmsJob {
         self.validate()?;
         if let Some(g) = &self.grading {
             return self.run_graded(g, progress, sink);
+        }
+        if self.blend.is_some() {
+            // A blend cannot be copied cell by cell: it is graded at a constant density.
+            let g = crate::mesh::graded::Grading {
+                field: std::sync::Arc::new(crate::field::density::DensityField::constant(
+                    self.density,
+                )),
+                clamp: false,
+            };
+            return self.run_graded(&g, progress, sink);
         }
         let (s, st) = (self.surface, self.structure);
         let range = calibrate::feasible(s, st);
@@ -243,6 +258,7 @@ impl TpmsJob {
             cell_size: self.domain.cell,
             cells: self.domain.counts(),
             grading: None,
+            blend: None,
             part,
         })
     }

@@ -8,6 +8,7 @@
 //! The lattice's phase is anchored at the box's lower corner, and the voxel size divides the
 //! cell, so every whole cell of the part is meshed exactly like the calibration's unit cell.
 
+pub mod blend;
 pub mod calibrate;
 pub mod graded;
 pub mod job;

@@ -101,7 +101,7 @@ pub fn mesh<G: Graded>(
     let build = |shift: &[f64]| {
         let shifts = between_centres(&grid, shift);
         LevelGrid::build(bounds, grid.cell(), margin, |p| {
-            kind.level(target(p) + shifts.at(p))
+            kind.level(p, target(p) + shifts.at(p))
         })
     };
     let mut levels = build(&shift);

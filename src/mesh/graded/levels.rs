@@ -93,11 +93,7 @@ impl LevelGrid {
         margin: f64,
         level: impl Fn(Vec3) -> f64 + Sync,
     ) -> LevelGrid {
-        let step = cell.map(|c| c / NODES_PER_CELL);
-        let origin = [0, 1, 2].map(|a| bounds.min[a] - (margin / step[a]).ceil() * step[a]);
-        let n =
-            [0, 1, 2].map(|a| ((bounds.max[a] + margin - origin[a]) / step[a]).ceil() as usize + 1);
-        let nodes = Nodes::sample(origin, step, n, level);
+        let nodes = Nodes::covering(bounds, cell.map(|c| c / NODES_PER_CELL), margin, level);
         LevelGrid {
             lipschitz: nodes.lipschitz(),
             mean: nodes.mean(),
@@ -183,6 +179,19 @@ pub struct GradedFamily<'a, L> {
     pub part: GradedPart<'a, L>,
 }
 
+impl<'a, L: Levelled> GradedFamily<'a, L> {
+    /// `lattice` with its level at each point read off `levels`.
+    pub fn new(lattice: L, levels: &'a LevelGrid) -> Self {
+        GradedFamily {
+            part: GradedPart {
+                lattice,
+                levels,
+                offset: 0.0,
+            },
+        }
+    }
+}
+
 impl<'a, L: Levelled> Family for GradedFamily<'a, L> {
     type Solid = GradedPart<'a, L>;
 
@@ -210,8 +219,8 @@ pub trait Graded: Sync {
     type Family<'a>: Family
     where
         Self: 'a;
-    /// The level of density `rho`.
-    fn level(&self, rho: f64) -> f64;
+    /// The level of density `rho` at `p` (the same everywhere but for a blend of types).
+    fn level(&self, p: Vec3, rho: f64) -> f64;
     /// The part whose level at each point is read off `levels`.
     fn family<'a>(&'a self, levels: &'a LevelGrid) -> Self::Family<'a>;
 }
@@ -230,18 +239,12 @@ impl<L: Levelled> Graded for Mapped<L> {
     where
         L: 'a;
 
-    fn level(&self, rho: f64) -> f64 {
+    fn level(&self, _p: Vec3, rho: f64) -> f64 {
         self.map.level(rho)
     }
 
     fn family<'a>(&'a self, levels: &'a LevelGrid) -> GradedFamily<'a, L> {
-        GradedFamily {
-            part: GradedPart {
-                lattice: self.lattice.clone(),
-                levels,
-                offset: 0.0,
-            },
-        }
+        GradedFamily::new(self.lattice.clone(), levels)
     }
 }
 
