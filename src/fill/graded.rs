@@ -8,7 +8,7 @@
 //! deeper than the skin, the blend and a voxel (the grid's error) and clear of the kept solids
 //! and the drain holes: there the written mesh is the lattice alone.
 
-use super::job::{closed_parts, FillJob, FillReport, Infilling};
+use super::job::{closed_parts, FillJob, FillReport, Filled, Infilling};
 use super::shape::{FillFamily, FillSolid, Infill, Shape};
 use crate::error::Result;
 use crate::field::{Aabb, Vec3};
@@ -262,30 +262,20 @@ impl FillJob {
         let mut part_report = done.part;
         let volume = part_report.volume.unwrap_or(f64::NAN);
         part_report.achieved_density = (volume - base) / (whole - base);
-        Ok(FillReport {
-            input: self.part_name.clone(),
-            repair: changes,
-            keep: self.keep.iter().map(|(n, _)| n.clone()).collect(),
-            skin: self.skin,
-            lattice: self.lattice_name.clone(),
-            structure: match &self.lattice {
-                Infilling::Tpms { structure, .. } => Some(*structure),
-                Infilling::Strut { .. } => None,
+        Ok(self.report(
+            changes,
+            shape.drains.clone(),
+            shape.memory_bytes(),
+            Filled {
+                level,
+                level_search: done.level_search,
+                part_volume: whole,
+                skin_volume: base,
+                resolution,
+                voxel,
+                grading: Some(done.grading),
+                part: part_report,
             },
-            cell_size: self.cell,
-            level,
-            blend: self.blend,
-            drains: shape.drains.clone(),
-            part_volume: whole,
-            skin_volume: base,
-            fill_volume: whole - base,
-            level_search: done.level_search,
-            resolution_requested: self.resolution,
-            resolution,
-            voxel_size: voxel,
-            distance_grid_bytes: shape.memory_bytes(),
-            grading: Some(done.grading),
-            part: part_report,
-        })
+        ))
     }
 }

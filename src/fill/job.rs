@@ -515,9 +515,48 @@ impl FillJob {
         warnings.append(&mut report.warnings);
         report.warnings = warnings;
         report.timings.total = start.elapsed().as_secs_f64();
-        Ok(FillReport {
+        Ok(self.report(
+            changes,
+            family.part.shape.drains.clone(),
+            grid_bytes,
+            Filled {
+                level,
+                level_search,
+                part_volume: family.base_volume + family.fill_volume,
+                skin_volume: family.base_volume,
+                resolution: resolved.resolution,
+                voxel,
+                grading: None,
+                part: report,
+            },
+        ))
+    }
+}
+
+/// What a fill's meshing found, for its report.
+pub(super) struct Filled {
+    pub level: f64,
+    pub level_search: LevelSearch,
+    pub part_volume: f64,
+    pub skin_volume: f64,
+    pub resolution: u32,
+    pub voxel: f64,
+    pub grading: Option<GradingReport>,
+    pub part: PartReport,
+}
+
+impl FillJob {
+    /// The job's report: its settings, the repairs made to its input and what the meshing found.
+    pub(super) fn report(
+        &self,
+        repair: Vec<Change>,
+        drains: Vec<Drain>,
+        grid_bytes: u64,
+        f: Filled,
+    ) -> FillReport {
+        FillReport {
             input: self.part_name.clone(),
-            repair: changes,
+            repair,
             keep: self.keep.iter().map(|(n, _)| n.clone()).collect(),
             skin: self.skin,
             lattice: self.lattice_name.clone(),
@@ -526,19 +565,19 @@ impl FillJob {
                 Infilling::Strut { .. } => None,
             },
             cell_size: self.cell,
-            level,
+            level: f.level,
             blend: self.blend,
-            drains: family.part.shape.drains.clone(),
-            part_volume: family.base_volume + family.fill_volume,
-            skin_volume: family.base_volume,
-            fill_volume: family.fill_volume,
-            level_search,
+            drains,
+            part_volume: f.part_volume,
+            skin_volume: f.skin_volume,
+            fill_volume: f.part_volume - f.skin_volume,
+            level_search: f.level_search,
             resolution_requested: self.resolution,
-            resolution: resolved.resolution,
-            voxel_size: voxel,
+            resolution: f.resolution,
+            voxel_size: f.voxel,
             distance_grid_bytes: grid_bytes,
-            grading: None,
-            part: report,
-        })
+            grading: f.grading,
+            part: f.part,
+        }
     }
 }
