@@ -11,7 +11,7 @@ use crate::check::self_intersect::{soup_self_intersections_shown, Stars};
 use crate::error::Result;
 use crate::mesh::topology::UnionFind;
 use crate::mesh::Mesh;
-use crate::mesh::{cross, norm, signed_volume, sub};
+use crate::mesh::{cross, norm, ordered_sum, signed_volume, sub};
 use crate::progress::Progress;
 use rayon::prelude::*;
 
@@ -290,42 +290,49 @@ fn measures(mesh: &Mesh) -> Measures {
         ]
     };
     let nc = components as usize;
-    // Per component: volume and bounds; the area.
+    // Per component: volume and bounds (for the cavity test).
     let empty = || {
         (
             vec![0.0f64; nc],
-            0.0f64,
             vec![[f64::INFINITY; 3]; nc],
             vec![[f64::NEG_INFINITY; 3]; nc],
         )
     };
-    let (vols, area, lo, hi) = idx
+    let (vols, lo, hi) = idx
         .par_chunks_exact(3)
-        .fold(empty, |(mut vols, mut area, mut lo, mut hi), t| {
+        .fold(empty, |(mut vols, mut lo, mut hi), t| {
             let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
             let k = comp[root[t[0] as usize] as usize] as usize;
             vols[k] += signed_volume(a, b, c);
-            area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
             for q in [a, b, c] {
                 for i in 0..3 {
                     lo[k][i] = lo[k][i].min(q[i]);
                     hi[k][i] = hi[k][i].max(q[i]);
                 }
             }
-            (vols, area, lo, hi)
+            (vols, lo, hi)
         })
         .reduce(empty, |mut x, y| {
             for k in 0..nc {
                 x.0[k] += y.0[k];
                 for i in 0..3 {
-                    x.2[k][i] = x.2[k][i].min(y.2[k][i]);
-                    x.3[k][i] = x.3[k][i].max(y.3[k][i]);
+                    x.1[k][i] = x.1[k][i].min(y.1[k][i]);
+                    x.2[k][i] = x.2[k][i].max(y.2[k][i]);
                 }
             }
-            x.1 += y.1;
             x
         });
-    let volume: f64 = vols.iter().sum();
+    // The totals added in a fixed order (the fold's split depends on scheduling), so the volume
+    // reported for a part does not change from run to run.
+    let tri = |i: usize| (p(idx[3 * i]), p(idx[3 * i + 1]), p(idx[3 * i + 2]));
+    let volume = ordered_sum(idx.len() / 3, |i| {
+        let (a, b, c) = tri(i);
+        signed_volume(a, b, c)
+    });
+    let area = ordered_sum(idx.len() / 3, |i| {
+        let (a, b, c) = tri(i);
+        0.5 * norm(cross(sub(b, a), sub(c, a)))
+    });
     let inside = |k: usize, j: usize| (0..3).all(|i| lo[j][i] <= lo[k][i] && hi[k][i] <= hi[j][i]);
     let cavities_enclosed = (0..nc)
         .filter(|&k| vols[k] < 0.0)

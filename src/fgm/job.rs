@@ -317,7 +317,8 @@ impl Fgm {
     /// The volume share of each material in the part (voxel count weighted).
     pub fn shares(&self) -> Vec<f64> {
         let n = self.composition.materials.len();
-        let (sum, count) = self
+        // Per block, then added in the blocks' order: the shares do not change with scheduling.
+        let per_block: Vec<(Vec<f64>, usize)> = self
             .blocks
             .par_iter()
             .map_init(
@@ -336,10 +337,14 @@ impl Fgm {
                     (sum, count)
                 },
             )
-            .reduce(
-                || (vec![0.0; n], 0),
-                |(a, i), (b, j)| (a.iter().zip(&b).map(|(x, y)| x + y).collect(), i + j),
-            );
+            .collect();
+        let (mut sum, mut count) = (vec![0.0; n], 0);
+        for (s, c) in per_block {
+            for k in 0..n {
+                sum[k] += s[k];
+            }
+            count += c;
+        }
         sum.iter().map(|s| s / count.max(1) as f64).collect()
     }
 
