@@ -53,6 +53,7 @@ fn one(config: &str) {
             clamp: false,
         }),
         blend: None,
+        cell_map: None,
     };
     let t = Instant::now();
     let mut sink = DiscardedStl::default();

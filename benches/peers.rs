@@ -217,6 +217,7 @@ fn child(a: &[String]) {
                 keep_fragments: false,
                 grading: None,
                 blend: None,
+                cell_map: None,
             };
             let mut sink =
                 latvox::io::sink::StlSink::create(&stl, latvox::io::StlFormat::Binary).unwrap();

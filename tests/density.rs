@@ -26,6 +26,7 @@ fn every_type_and_structure_hits_its_target_within_0_002() {
                     keep_fragments: false,
                     grading: None,
                     blend: None,
+                    cell_map: None,
                 };
                 let (mesh, r) = job.run(&latvox::progress::Progress::hidden()).unwrap();
                 assert!(

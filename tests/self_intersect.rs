@@ -88,6 +88,7 @@ fn tpms_mesh(surface: Surface, structure: Structure, cells: u32, resolution: u32
         keep_fragments: false,
         grading: None,
         blend: None,
+        cell_map: None,
     };
     job.run(&Progress::hidden()).unwrap().0
 }

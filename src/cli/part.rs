@@ -31,6 +31,8 @@ const PART_KEYS: &[(&str, &[&str])] = &[
             "clamp",
             "blend-to",
             "blend-field",
+            "cell-map",
+            "bore",
             "allow-islands",
         ],
     ),

@@ -47,6 +47,10 @@ Examples:
   # An F-RD net at 30 %: its first labyrinth falls apart there, its other one holds together
   latvox tpms --type frd --density 0.3 --side other --cells 3 -o frd.stl
 
+  # A tube (a stent's or a heat exchanger's wall): 12 gyroid cells around a 10 mm bore, one
+  # through the 4 mm wall, 4 along; whole cells around, every cell at 30 %
+  latvox tpms --type gyroid --cell-map cylindrical --bore 10 --cells 12,1,4 --cell-size 4 -o tube.stl
+
   # Save the part's settings as a part file; make it again, here with finer voxels
   latvox tpms --type d --density 0.25 --cells 4 -o d.stl --save-part d.toml
   latvox tpms --part d.toml --resolution 48 -o d-fine.stl
@@ -91,6 +95,20 @@ pub struct TpmsArgs {
         allow_hyphen_values = true
     )]
     pub blend_field: Option<String>,
+    /// Wrap the cells around the z axis through --origin (a tube, its lower end at --origin):
+    /// --cells gives the cells around, through the wall and along the axis (12,1,4 by default),
+    /// --cell-size the cell's size through the wall and along the axis (5 mm by default), --bore
+    /// the inner radius. Whole cells around: no cell is cut at the seam.
+    #[arg(long, value_name = "cylindrical", value_parser = ["cylindrical"], requires = "bore")]
+    pub cell_map: Option<String>,
+    /// Inner radius of a --cell-map tube, mm.
+    #[arg(
+        long,
+        value_name = "MM",
+        requires = "cell_map",
+        allow_hyphen_values = true
+    )]
+    pub bore: Option<f64>,
     /// The box of cells.
     #[command(flatten)]
     pub domain: BoxArgs,
@@ -137,10 +155,36 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
 }
 
 impl TpmsArgs {
+    /// The tube of a --cell-map part: cells around, through the wall and along from --cells
+    /// (12,1,4 by default), their size through the wall and along from --cell-size (5 mm).
+    fn cell_map(&self) -> Result<Option<latvox::field::cellmap::Cylindrical>> {
+        let (Some(_), Some(bore)) = (&self.cell_map, self.bore) else {
+            return Ok(None);
+        };
+        let d = &self.domain;
+        if d.size.is_some() {
+            return Err(latvox::Error::invalid(
+                "--cell-map makes a tube from --cells, --cell-size and --bore: --size is not used",
+            ));
+        }
+        let cells = d.cells.unwrap_or([12, 1, 4]);
+        let cell = match d.cell_size {
+            None => [5.0, 5.0],
+            Some([a, b, c]) if a == b && b == c => [a, a],
+            Some(_) => {
+                return Err(latvox::Error::invalid(
+                    "with --cell-map, --cell-size is one size (through the wall and along the axis); the cells around follow from --cells and --bore",
+                ))
+            }
+        };
+        latvox::field::cellmap::Cylindrical::new(d.origin, bore, cells, cell).map(Some)
+    }
+
     /// The job the options describe.
     pub fn job(&self) -> Result<TpmsJob> {
         let m = &self.mesh;
         let o = m.options();
+        let cell_map = self.cell_map()?;
         let domain = self.domain.domain()?;
         let bounds = domain.bounds();
         let grading = self.grade.grading(&bounds)?;
@@ -167,6 +211,7 @@ impl TpmsArgs {
             memory: o.memory,
             keep_fragments: o.keep_fragments,
             grading,
+            cell_map,
             blend: match (self.blend_to, &self.blend_field) {
                 (Some(to), Some(f)) => Some(latvox::tpms::blend::Blend {
                     to,
@@ -187,6 +232,18 @@ fn print_tpms_summary(r: &TpmsReport) {
     let blend = match &r.blend {
         Some(b) => format!(" blended to {} by {}", b.to.name(), b.weight),
         None => String::new(),
+    };
+    let (blend, cells) = match &r.cell_map {
+        Some(m) => (
+            format!(
+                "{blend} tube, bore {} mm, outer radius {} mm, {} mm long",
+                human(m.map.bore, 4),
+                human(m.outer_radius, 4),
+                human(m.length, 4)
+            ),
+            format!("{cells} (around × through × along)"),
+        ),
+        None => (blend, cells),
     };
     outln!(
         "{} {}{blend} · {cells} cells of {} mm · {} voxels/cell ({} mm)",
@@ -209,5 +266,13 @@ fn print_tpms_summary(r: &TpmsReport) {
         p.density_error.unwrap_or(f64::NAN),
         r.level
     );
+    if let Some(m) = r.cell_map.as_ref().filter(|m| m.layer_densities.len() > 1) {
+        let layers: Vec<String> = m
+            .layer_densities
+            .iter()
+            .map(|d| format!("{d:.4}"))
+            .collect();
+        outln!("layers    {} (bore outwards)", layers.join("  "));
+    }
     print_part(p);
 }

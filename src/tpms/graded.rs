@@ -13,7 +13,6 @@ use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
 use crate::io::sink::MeshSink;
 use crate::mesh::graded::{self, Feasible, Grading, LevelGrid, LevelMap, Levelled, Mapped, Run};
-use crate::mesh::pipeline::Options;
 use crate::mesh::report::Timings;
 use crate::progress::Progress;
 use std::time::Instant;
@@ -227,14 +226,7 @@ impl TpmsJob {
             bounds,
             phase: bounds.min,
         };
-        let opts = Options {
-            adaptivity: self.adaptivity,
-            verify: self.verify,
-            instancing: false,
-            tile: self.tile,
-            memory: self.memory,
-            keep_fragments: self.keep_fragments,
-        };
+        let opts = self.options(false, false);
         let run = Run {
             grading,
             targets,
@@ -286,6 +278,7 @@ impl TpmsJob {
                 to: b.to,
                 weight: b.weight.source.clone(),
             }),
+            cell_map: None,
             part: done.part,
         })
     }

@@ -55,6 +55,8 @@ pub struct TpmsJob {
     pub grading: Option<crate::mesh::graded::Grading>,
     /// A second type blended in by a weight that varies through the part.
     pub blend: Option<super::blend::Blend>,
+    /// Cells wrapped around an axis (the domain's box is then not used).
+    pub cell_map: Option<crate::field::cellmap::Cylindrical>,
 }
 
 /// The JSON report of a TPMS job.
@@ -93,6 +95,9 @@ pub struct TpmsReport {
     /// The type blended to and its weight field.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub blend: Option<super::blend::BlendReport>,
+    /// The tube of a cell-mapped part, and each layer's density.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cell_map: Option<super::mapped::CellMapReport>,
     /// The part as written: density, mesh, checks, timings, warnings.
     #[serde(flatten)]
     pub part: PartReport,
@@ -110,9 +115,9 @@ impl TpmsJob {
     /// The part as an implicit solid, at the level the part is meshed at.
     pub fn model(&self) -> Result<crate::render::Model> {
         self.validate()?;
-        if self.grading.is_some() || self.blend.is_some() {
+        if self.grading.is_some() || self.blend.is_some() || self.cell_map.is_some() {
             return Err(Error::invalid(
-                "a graded part is drawn and sliced from its mesh: make it with -o part.stl, then render, view or slice part.stl",
+                "a graded or cell-mapped part is drawn and sliced from its mesh: make it with -o part.stl, then render, view or slice part.stl",
             ));
         }
         let bounds = self.domain.bounds();
@@ -164,6 +169,9 @@ impl TpmsJob {
     pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<TpmsReport> {
         let start = Instant::now();
         self.validate()?;
+        if let Some(map) = self.cell_map {
+            return self.run_mapped(map, progress, sink);
+        }
         if let Some(g) = &self.grading {
             return self.run_graded(g, progress, sink);
         }
@@ -184,24 +192,10 @@ impl TpmsJob {
         let table_start = Instant::now();
         let t0 = calibrate::analytic_level(s, st, self.density);
         let table_seconds = table_start.elapsed().as_secs_f64();
-        let opts = Options {
-            adaptivity: self.adaptivity,
-            verify: self.verify,
-            instancing: self.instancing,
-            tile: self.tile,
-            memory: self.memory,
-            // Islands asked for are kept: the solid is meant to fall apart.
-            keep_fragments: self.keep_fragments || !conn.solid,
-        };
+        // Islands asked for are kept: the solid is meant to fall apart.
+        let opts = self.options(self.instancing, !conn.solid);
         let mut calibrate_seconds = table_seconds;
-        let request = resolution::Request {
-            part: format!("the {} {}", s.name(), st.name()),
-            setting: format!("density {}", self.density),
-            requested: self.resolution,
-            thin: self.thin_walls(t0),
-            density: Some(self.density),
-            auto: self.auto_resolution,
-        };
+        let request = self.request(format!("the {} {}", s.name(), st.name()), t0);
         let resolved = resolution::search(&request, &mut |r| {
             let _p = progress.stage(if r == self.resolution {
                 "calibrating and meshing"
@@ -259,13 +253,14 @@ impl TpmsJob {
             cells: self.domain.counts(),
             grading: None,
             blend: None,
+            cell_map: None,
             part,
         })
     }
 
     /// Whether the solid and the void are each one piece at this density; outside the feasible
     /// range the job is refused unless islands are allowed. Warnings for what is allowed.
-    fn connectivity(&self, range: FeasibleRange) -> Result<(Connectivity, Vec<String>)> {
+    pub(super) fn connectivity(&self, range: FeasibleRange) -> Result<(Connectivity, Vec<String>)> {
         let (s, st) = (self.surface, self.structure);
         let voids = calibrate::void_connected_range(s, st);
         let conn = Connectivity {
@@ -308,6 +303,32 @@ impl TpmsJob {
             );
         }
         Ok((conn, warnings))
+    }
+
+    /// The pipeline's options for this job; fragments kept when asked, or when `islands` (the
+    /// solid is meant to fall apart).
+    pub(super) fn options(&self, instancing: bool, islands: bool) -> Options {
+        Options {
+            adaptivity: self.adaptivity,
+            verify: self.verify,
+            instancing,
+            tile: self.tile,
+            memory: self.memory,
+            keep_fragments: self.keep_fragments || islands,
+        }
+    }
+
+    /// The resolution search's request for `part` ("the gyroid net") at the density, its sheet
+    /// walls read at the level `t0`.
+    pub(super) fn request(&self, part: String, t0: f64) -> resolution::Request {
+        resolution::Request {
+            part,
+            setting: format!("density {}", self.density),
+            requested: self.resolution,
+            thin: self.thin_walls(t0),
+            density: Some(self.density),
+            auto: self.auto_resolution,
+        }
     }
 
     /// The resolution sheet walls need, when the requested one leaves them thinner than

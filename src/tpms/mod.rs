@@ -12,6 +12,7 @@ pub mod blend;
 pub mod calibrate;
 pub mod graded;
 pub mod job;
+pub mod mapped;
 pub mod surface;
 
 pub use calibrate::{Calibration, FeasibleRange};

@@ -1,0 +1,373 @@
+//! TPMS lattices on a conformal cell map: cells wrapped around an axis
+//! ([`crate::field::cellmap`]), the lattice `F(u(p))` cut by the tube. The part goes through the
+//! one pipeline ([`crate::mesh::pipeline`]): meshed whole (or in tiles), its level found on the
+//! part itself against the tube's volume.
+//!
+//! With one cell through the wall and whole cells around and along, every cell is the image of
+//! every other under a turn about the axis or a shift along it, so the part's density is each
+//! cell's. With several cells through the wall the map's Jacobian (∝ r) weighs the layers
+//! differently: the density of each layer is measured on the mesh (the solid within each radius,
+//! by the divergence theorem) and reported.
+
+use super::calibrate::{self, Connectivity};
+use super::job::TpmsJob;
+use super::{Structure, Surface, TpmsField, TpmsReport};
+use crate::error::{Error, Result};
+use crate::field::cellmap::Cylindrical;
+use crate::field::{intersection_clearance, Aabb, Field, Vec3};
+use crate::grid::GridSpec;
+use crate::io::sink::{MeshSink, Triangle};
+use crate::mesh::pipeline::{self, Family, Route, Solid};
+use crate::mesh::report::{LevelSearch, PartReport, Timings};
+use crate::mesh::resolution;
+use crate::progress::Progress;
+use std::time::Instant;
+
+/// A TPMS lattice wrapped around an axis and cut by its tube, at one level.
+#[derive(Debug, Clone, Copy)]
+pub struct MappedLattice {
+    /// Which minimal surface.
+    pub surface: Surface,
+    /// Net, sheet or the other labyrinth.
+    pub structure: Structure,
+    /// The level `t`.
+    pub level: f64,
+    /// The cell map (and the tube it fills).
+    pub map: Cylindrical,
+}
+
+/// The mapped lattice's field: the first-order distance `(F∘u − t)/|∇(F∘u)|` cut by the tube.
+struct MappedField {
+    /// The surface with unit cells at the origin: `distance_at` and `implicit_at` in cell
+    /// coordinates.
+    tpms: TpmsField,
+    map: Cylindrical,
+    /// `|∇(F∘u)|` bound at half the bore and beyond.
+    lipschitz: f64,
+}
+
+impl MappedField {
+    /// `F`, the implicit function and its gradient in world coordinates.
+    #[inline(always)]
+    fn eval(&self, p: Vec3) -> (f64, f64, Vec3) {
+        let (u, j) = self.map.coords(p);
+        let (f, g) = self.tpms.surface.eval(u);
+        let gw = [0, 1, 2].map(|i| g[0] * j[0][i] + g[1] * j[1][i] + g[2] * j[2][i]);
+        (f, self.tpms.implicit_at(f, self.tpms.level), gw)
+    }
+
+    /// The lattice's clearance: its implicit value over the gradient bound, within a ball that
+    /// keeps out of the inner half of the bore (where the bound no longer holds).
+    fn lattice_clearance(&self, p: Vec3, implicit: f64) -> f64 {
+        let room = self.map.radius(p) - 0.5 * self.map.bore;
+        if room <= 0.0 {
+            return 0.0;
+        }
+        (implicit.abs() / self.lipschitz).min(room)
+    }
+}
+
+impl Field for MappedField {
+    fn value(&self, p: Vec3) -> f64 {
+        self.value_and_clearance(p).0
+    }
+
+    fn clearance(&self, p: Vec3) -> f64 {
+        self.value_and_clearance(p).1
+    }
+
+    fn value_and_clearance(&self, p: Vec3) -> (f64, f64) {
+        let (f, v, g) = self.eval(p);
+        let a = self.tpms.distance_at(f, g, self.tpms.level);
+        let ca = self.lattice_clearance(p, v);
+        let b = self.map.value(p).clamp(-self.tpms.clamp, self.tpms.clamp);
+        let cb = self.map.value(p).abs();
+        (a.max(b), intersection_clearance(a, ca, b, cb))
+    }
+
+    fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
+        let (f, v, g) = self.eval(p);
+        let sign = match self.tpms.structure {
+            Structure::Net => 1.0,
+            Structure::Sheet => f.signum(),
+            Structure::NetOther => -1.0,
+        };
+        let g = g.map(|x| sign * x);
+        let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt().max(1e-12);
+        let (b, gb) = self.map.implicit_with_gradient(p);
+        // Whichever of the two solids is the boundary here, in the same (distance) units.
+        if b > v / n {
+            (b, gb)
+        } else {
+            (v / n, g.map(|x| x / n))
+        }
+    }
+}
+
+impl Solid for MappedLattice {
+    fn field(&self, spec: &GridSpec) -> Box<dyn Field + '_> {
+        let tpms = TpmsField::new(
+            self.surface,
+            self.structure,
+            self.level,
+            [1.0; 3],
+            [0.0; 3],
+            spec.half_width * spec.voxel,
+        );
+        Box::new(MappedField {
+            tpms,
+            map: self.map,
+            lipschitz: self
+                .map
+                .lipschitz(self.surface.lipschitz_per_axis(), 0.5 * self.map.bore),
+        })
+    }
+
+    fn bounds(&self) -> Aabb {
+        self.map.bounds()
+    }
+
+    fn with_bounds(&self, _bounds: Aabb) -> Self {
+        // Only periodic solids are clipped to other boxes (templates, calibration cells).
+        *self
+    }
+
+    fn period(&self) -> Option<Vec3> {
+        None
+    }
+}
+
+/// The mapped lattice at every level; its density is its share of the tube.
+#[derive(Debug, Clone, Copy)]
+pub struct MappedFamily {
+    /// The part at some level (replaced).
+    pub part: MappedLattice,
+}
+
+impl Family for MappedFamily {
+    type Solid = MappedLattice;
+
+    fn at(&self, level: f64) -> MappedLattice {
+        MappedLattice { level, ..self.part }
+    }
+
+    fn model_fraction(&self, level: f64) -> f64 {
+        calibrate::analytic_fraction(self.part.surface, self.part.structure, level)
+    }
+
+    fn model_level(&self, fraction: f64) -> f64 {
+        calibrate::analytic_level(self.part.surface, self.part.structure, fraction)
+    }
+
+    fn fraction(&self, volume: f64, _bounds: &Aabb) -> f64 {
+        volume / self.part.map.volume()
+    }
+}
+
+/// The tube and how its layers met the density.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CellMapReport {
+    /// `cylindrical`.
+    pub kind: &'static str,
+    /// The map: axis, bore, cells, sizes.
+    #[serde(flatten)]
+    pub map: Cylindrical,
+    /// Outer radius, mm.
+    pub outer_radius: f64,
+    /// Length along the axis, mm.
+    pub length: f64,
+    /// The tube's volume, mm³ (the density's base).
+    pub tube_volume: f64,
+    /// The density of each layer of cells through the wall, bore outwards, measured on the
+    /// written mesh.
+    pub layer_densities: Vec<f64>,
+}
+
+impl TpmsJob {
+    /// Runs a job on a cylindrical cell map.
+    pub(super) fn run_mapped(
+        &self,
+        map: Cylindrical,
+        progress: &Progress,
+        sink: &mut dyn MeshSink,
+    ) -> Result<TpmsReport> {
+        let start = Instant::now();
+        if self.grading.is_some() || self.blend.is_some() {
+            return Err(Error::invalid(
+                "--cell-map makes a uniform density: a graded or blended tube is not supported yet",
+            ));
+        }
+        let (s, st) = (self.surface, self.structure);
+        let range = calibrate::feasible(s, st);
+        let (conn, mut warnings): (Connectivity, Vec<String>) = self.connectivity(range)?;
+        let t0 = calibrate::analytic_level(s, st, self.density);
+        let opts = self.options(false, !conn.solid);
+        let request = self.request(format!("the {} {} tube", s.name(), st.name()), t0);
+        let mut calibrate_seconds = 0.0;
+        let mut calibration = None;
+        let resolved = resolution::search(&request, &mut |r| {
+            let _p = progress.stage("calibrating and meshing the tube");
+            let voxel = map.shortest_edge() / r as f64;
+            let t = Instant::now();
+            // The unit cell at the middle of the wall: a first level.
+            let cal = calibrate::calibrate(
+                s,
+                st,
+                self.density,
+                map.mid_cell(),
+                voxel,
+                [1e6; 3],
+                self.adaptivity,
+            )?;
+            calibrate_seconds += t.elapsed().as_secs_f64();
+            let level = if cal.converged {
+                cal.level
+            } else {
+                cal.analytic_level
+            };
+            calibration = Some(cal);
+            let family = MappedFamily {
+                part: MappedLattice {
+                    surface: s,
+                    structure: st,
+                    level,
+                    map,
+                },
+            };
+            let route = Route::choose(&family.part, voxel, &opts);
+            let solved = pipeline::solve(&family, self.density, level, voxel, route, &opts)?;
+            Ok(if solved.met {
+                Ok((voxel, family, route, solved))
+            } else {
+                Err(solved.best.fraction)
+            })
+        })?;
+        warnings.extend(resolved.raised);
+        let (voxel, family, route, solved) = resolved.found;
+        let level = solved.best.level;
+        let level_search = LevelSearch::new(&solved.best, route, &solved.tried, resolved.coarser);
+        // The layers are measured on the written triangles on their way to the sink.
+        let mut layers = Layers::new(map, sink);
+        let written = pipeline::write(
+            &family,
+            solved.best,
+            voxel,
+            route,
+            &opts,
+            progress,
+            &mut layers,
+        )?;
+        let layer_densities = layers.densities();
+        let volume = written.measures.volume;
+        let mut part = PartReport::new(
+            map.bounds(),
+            Some(self.density),
+            route,
+            written,
+            solved.meshing,
+            Timings {
+                calibrate: calibrate_seconds,
+                ..Timings::default()
+            },
+        );
+        part.density_against(self.density, volume / map.volume());
+        for (k, d) in layer_densities.iter().enumerate() {
+            if (d - self.density).abs() > 0.005 {
+                part.warnings.push(format!(
+                    "layer {} of {} through the wall holds {d:.4}, the tube {:.4}: the map's Jacobian weighs the layers differently",
+                    k + 1,
+                    layer_densities.len(),
+                    volume / map.volume()
+                ));
+            }
+        }
+        warnings.append(&mut part.warnings);
+        part.warnings = warnings;
+        part.timings.total = start.elapsed().as_secs_f64();
+        Ok(TpmsReport {
+            surface: s,
+            structure: st,
+            level,
+            calibration: calibration.expect("the resolution search calibrated"),
+            level_search,
+            feasible_range: range,
+            connectivity: conn,
+            resolution_requested: self.resolution,
+            resolution: resolved.resolution,
+            voxel_size: voxel,
+            thinnest_wall_voxels: (st == Structure::Sheet)
+                .then(|| calibrate::thinnest_sheet_wall(s, t0) * map.shortest_edge() / voxel),
+            cell_size: map.mid_cell(),
+            cells: map.cells.map(f64::from),
+            grading: None,
+            blend: None,
+            cell_map: Some(CellMapReport {
+                kind: "cylindrical",
+                map,
+                outer_radius: map.outer(),
+                length: map.length(),
+                tube_volume: map.volume(),
+                layer_densities,
+            }),
+            part,
+        })
+    }
+}
+
+/// A sink that passes the triangles on and measures, as they pass, the solid within each
+/// radius between two layers of cells (bore to outer wall).
+struct Layers<'a> {
+    sink: &'a mut dyn MeshSink,
+    map: Cylindrical,
+    within: Vec<f64>,
+}
+
+impl<'a> Layers<'a> {
+    fn new(map: Cylindrical, sink: &'a mut dyn MeshSink) -> Self {
+        Layers {
+            sink,
+            map,
+            within: vec![0.0; map.cells[1] as usize + 1],
+        }
+    }
+
+    fn radius(&self, k: usize) -> f64 {
+        self.map.bore + k as f64 * self.map.cell[0]
+    }
+
+    /// The density of each layer: the solid between its two radii over the ring's volume.
+    fn densities(&self) -> Vec<f64> {
+        (0..self.within.len() - 1)
+            .map(|k| {
+                let (r0, r1) = (self.radius(k), self.radius(k + 1));
+                let ring = std::f64::consts::PI * (r1 * r1 - r0 * r0) * self.map.length();
+                (self.within[k + 1] - self.within[k]) / ring
+            })
+            .collect()
+    }
+}
+
+impl MeshSink for Layers<'_> {
+    fn begin(&mut self, triangles: Option<u64>) -> Result<()> {
+        self.sink.begin(triangles)
+    }
+
+    fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
+        use rayon::prelude::*;
+        let tri = |t: &Triangle| t.map(|p| p.map(f64::from));
+        for k in 0..self.within.len() {
+            let r = self.radius(k);
+            // Fixed chunks added in order: the same sum whatever the scheduling.
+            let parts: Vec<f64> = batch
+                .par_chunks(4096)
+                .map(|c| self.map.volume_within(c.iter().map(tri), r))
+                .collect();
+            self.within[k] += parts.iter().sum::<f64>();
+        }
+        self.sink.triangles(batch)
+    }
+
+    fn finish(&mut self) -> Result<()> {
+        self.sink.finish()
+    }
+}
