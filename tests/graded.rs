@@ -970,11 +970,11 @@ fn a_sheet_tube_of_several_layers_holds_the_density_in_every_cell() {
     eprintln!("diamond sheet tube: largest cell error {worst:.4}");
 }
 
-/// Bad tubes: one line, exit 2, no file.
+/// Bad tubes and cell-size grades: one line, exit 2, no file.
 #[test]
 fn bad_cell_maps_are_refused() {
     let dir = tempdir();
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 11] = [
         (&["--cell-map", "cylindrical"], "--bore"),
         (&["--cell-map", "spherical", "--bore", "5"], "spherical"),
         (
@@ -1018,6 +1018,20 @@ fn bad_cell_maps_are_refused() {
             ],
             "a graded or blended tube",
         ),
+        (&["--cell-size-grade", "w:3:5"], "AXIS:A:B"),
+        (&["--cell-size-grade", "z:3"], "AXIS:A:B"),
+        (&["--cell-size-grade", "z:0:5"], "positive lengths"),
+        (
+            &[
+                "--cell-size-grade",
+                "z:3:5",
+                "--cell-map",
+                "cylindrical",
+                "--bore",
+                "4",
+            ],
+            "cannot be used with",
+        ),
     ];
     let before = files_in(dir.path());
     for (extra, what) in cases {
@@ -1025,5 +1039,95 @@ fn bad_cell_maps_are_refused() {
         args.extend_from_slice(extra);
         let out = run(&args, dir.path());
         assert_refusal(dir.path(), &before, &out, &args, what);
+    }
+}
+
+/// Cells growing along z from 3 to 8 mm through a 30 mm block (scaled so whole cells span it):
+/// closed and clean by CGAL, one piece by manifold3d, every cell (cut at the faces the report
+/// gives, each checked here to be one more cell of the test's own integral of 1/s) within
+/// ±0.005 of the density.
+#[test]
+fn cells_growing_along_an_axis_are_whole_and_hold_the_density() {
+    let dir = tempdir();
+    let args = [
+        "tpms",
+        "--type",
+        "gyroid",
+        "--size",
+        "15,15,30",
+        "--cell-size",
+        "5",
+        "--origin",
+        "1,-2,0.5",
+        "--cell-size-grade",
+        "z:3:8",
+        "--density",
+        "0.3",
+        "-r",
+        "16",
+        "--verify",
+        "cgal",
+        "-q",
+        "-o",
+        "g.stl",
+        "--report",
+        "g.json",
+    ];
+    ok(&args, dir.path());
+    let r = json(&dir.path().join("g.json"));
+    let checks = &r["checks"];
+    assert_eq!(checks["checked_by"], "CGAL");
+    for key in ["closed", "manifold", "outward"] {
+        assert_eq!(checks[key], true, "{key}");
+    }
+    assert_eq!(checks["self_intersecting"], false);
+    let map = &r["cell_map"];
+    assert_eq!(map["kind"], "graded");
+    let faces: Vec<f64> = map["faces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    // 30·ln(8/3)/5 = 5.9 cells: 6, sizes scaled by 0.98; the faces are where the integral of
+    // 1/s (s linear from a to b, computed here) reaches each whole number.
+    assert_eq!(faces.len(), 7);
+    let (a, b) = (
+        3.0 * 30.0 * (8.0f64 / 3.0).ln() / 5.0 / 6.0,
+        8.0 * 30.0 * (8.0f64 / 3.0).ln() / 5.0 / 6.0,
+    );
+    for (i, f) in faces.iter().enumerate() {
+        let x = f - 0.5;
+        let s = a + (b - a) * x / 30.0;
+        let cells = 30.0 / (b - a) * (s / a).ln();
+        assert!(
+            (cells - i as f64).abs() < 1e-9,
+            "face {i} at {f}: {cells} cells"
+        );
+    }
+    let given = format!(
+        "z:{}",
+        faces
+            .iter()
+            .map(|f| f.to_string())
+            .collect::<Vec<_>>()
+            .join(",")
+    );
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checkers/cell_density.py");
+    let o = std::process::Command::new("python3")
+        .arg(script)
+        .arg(dir.path().join("g.stl"))
+        .args(["1,-2,0.5", "5,5,5", "15,15,30", &given])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(m["status"], "Error.NoError");
+    assert_eq!(m["components"], 1);
+    let cells = m["cells"].as_array().unwrap();
+    assert_eq!(cells.len(), 3 * 3 * 6);
+    for c in cells {
+        let f = c[3].as_f64().unwrap();
+        assert!((f - 0.3).abs() <= 0.005, "cell {c} holds {f:.4}");
     }
 }

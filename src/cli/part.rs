@@ -33,6 +33,7 @@ const PART_KEYS: &[(&str, &[&str])] = &[
             "blend-field",
             "cell-map",
             "bore",
+            "cell-size-grade",
             "allow-islands",
         ],
     ),

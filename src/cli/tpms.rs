@@ -51,6 +51,9 @@ Examples:
   # through the 4 mm wall, 4 along; whole cells around, every cell at 30 %
   latvox tpms --type gyroid --cell-map cylindrical --bore 10 --cells 12,1,4 --cell-size 4 -o tube.stl
 
+  # Cells 3 mm at the bottom of a 40 mm block growing to 8 mm at its top, each one whole
+  latvox tpms --type gyroid --size 20,20,40 --cell-size 5 --cell-size-grade z:3:8 -o grown.stl
+
   # Save the part's settings as a part file; make it again, here with finer voxels
   latvox tpms --type d --density 0.25 --cells 4 -o d.stl --save-part d.toml
   latvox tpms --part d.toml --resolution 48 -o d-fine.stl
@@ -101,6 +104,11 @@ pub struct TpmsArgs {
     /// the inner radius. Whole cells around: no cell is cut at the seam.
     #[arg(long, value_name = "cylindrical", value_parser = ["cylindrical"], requires = "bore")]
     pub cell_map: Option<String>,
+    /// Grade the cell size along an axis: AXIS:A:B, cells A mm at the box's lower face growing
+    /// to B mm at its upper one (as z:3:6), scaled a little so that whole cells span the box
+    /// (the cell size along the other axes from --cell-size); no cell is torn.
+    #[arg(long, value_name = "AXIS:A:B", conflicts_with = "cell_map")]
+    pub cell_size_grade: Option<String>,
     /// Inner radius of a --cell-map tube, mm.
     #[arg(
         long,
@@ -157,7 +165,30 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
 impl TpmsArgs {
     /// The tube of a --cell-map part: cells around, through the wall and along from --cells
     /// (12,1,4 by default), their size through the wall and along from --cell-size (5 mm).
-    fn cell_map(&self) -> Result<Option<latvox::field::cellmap::Cylindrical>> {
+    fn cell_map(&self) -> Result<Option<latvox::field::cellmap::Mapping>> {
+        use latvox::field::cellmap::{GradedCells, Mapping};
+        if let Some(g) = &self.cell_size_grade {
+            let bad = || {
+                latvox::Error::invalid(format!(
+                    "a cell-size grade is AXIS:A:B, as z:3:6 (cells 3 mm at the lower face growing to 6 mm), got '{g}'"
+                ))
+            };
+            let parts: Vec<&str> = g.split(':').collect();
+            let [axis, a, b] = parts[..] else {
+                return Err(bad());
+            };
+            let axis = ["x", "y", "z"]
+                .iter()
+                .position(|x| x.eq_ignore_ascii_case(axis))
+                .ok_or_else(bad)?;
+            let (a, b): (f64, f64) = (
+                a.trim().parse().map_err(|_| bad())?,
+                b.trim().parse().map_err(|_| bad())?,
+            );
+            let d = self.domain.domain()?;
+            return GradedCells::new(d.bounds(), axis, a, b, d.cell)
+                .map(|m| Some(Mapping::Graded(m)));
+        }
         let (Some(_), Some(bore)) = (&self.cell_map, self.bore) else {
             return Ok(None);
         };
@@ -177,7 +208,8 @@ impl TpmsArgs {
                 ))
             }
         };
-        latvox::field::cellmap::Cylindrical::new(d.origin, bore, cells, cell).map(Some)
+        latvox::field::cellmap::Cylindrical::new(d.origin, bore, cells, cell)
+            .map(|m| Some(Mapping::Cylindrical(m)))
     }
 
     /// The job the options describe.
@@ -233,15 +265,30 @@ fn print_tpms_summary(r: &TpmsReport) {
         Some(b) => format!(" blended to {} by {}", b.to.name(), b.weight),
         None => String::new(),
     };
+    use latvox::tpms::mapped::CellMapReport;
     let (blend, cells) = match &r.cell_map {
-        Some(m) => (
+        Some(CellMapReport::Cylindrical {
+            map,
+            outer_radius,
+            length,
+            ..
+        }) => (
             format!(
                 "{blend} tube, bore {} mm, outer radius {} mm, {} mm long",
-                human(m.map.bore, 4),
-                human(m.outer_radius, 4),
-                human(m.length, 4)
+                human(map.bore, 4),
+                human(*outer_radius, 4),
+                human(*length, 4)
             ),
             format!("{cells} (around × through × along)"),
+        ),
+        Some(CellMapReport::Graded { map, .. }) => (
+            format!(
+                "{blend}, cells growing along {} from {} to {} mm",
+                ["x", "y", "z"][map.axis],
+                human(map.ends[0], 4),
+                human(map.ends[1], 4)
+            ),
+            cells,
         ),
         None => (blend, cells),
     };
@@ -266,12 +313,11 @@ fn print_tpms_summary(r: &TpmsReport) {
         p.density_error.unwrap_or(f64::NAN),
         r.level
     );
-    if let Some(m) = r.cell_map.as_ref().filter(|m| m.layer_densities.len() > 1) {
-        let layers: Vec<String> = m
-            .layer_densities
-            .iter()
-            .map(|d| format!("{d:.4}"))
-            .collect();
+    if let Some(CellMapReport::Cylindrical {
+        layer_densities, ..
+    }) = r.cell_map.as_ref().filter(|_| r.cells[1] > 1.0)
+    {
+        let layers: Vec<String> = layer_densities.iter().map(|d| format!("{d:.4}")).collect();
         outln!("layers    {} (bore outwards)", layers.join("  "));
     }
     print_part(p);

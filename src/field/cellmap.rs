@@ -12,10 +12,250 @@
 //! 1, so no cell is cut), cells of `a_r` through the wall from the bore `R` out, and of `a_z`
 //! along the axis. The map is smooth and one-to-one on the wall, so the solid keeps the
 //! topology of a box of cells joined around: what holds together in a box holds together here.
+//!
+//! The graded map ([`GradedCells`]) keeps a box but lets the cell size grow linearly along one
+//! axis, `s(x) = a + (b − a)·x/L`: `u = ∫dx/s = L/(b − a)·ln(s(x)/a)`, its ends scaled so that a
+//! whole number of cells spans the box (cells are not torn: each is the image of a unit cell).
 
 use super::{Aabb, Field, Vec3};
 use crate::error::{Error, Result};
 use std::f64::consts::TAU;
+
+/// The cell maps a part can be made on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Mapping {
+    /// Cells wrapped around an axis.
+    Cylindrical(Cylindrical),
+    /// Cells growing along an axis of a box.
+    Graded(GradedCells),
+}
+
+/// A map from space to cell coordinates, and the region its cells fill.
+pub trait CellMap: Copy + Send + Sync + std::fmt::Debug {
+    /// Cell coordinates of `p` and the gradient of each (the Jacobian's rows), per mm.
+    fn coords(&self, p: Vec3) -> (Vec3, [Vec3; 3]);
+    /// A bound on `|∇(F∘u)|` per mm from bounds `l` on `|∂F/∂u_a|`, valid within
+    /// [`CellMap::room`] of a point.
+    fn lipschitz(&self, l: Vec3) -> f64;
+    /// The radius around `p` within which [`CellMap::lipschitz`] holds.
+    fn room(&self, p: Vec3) -> f64;
+    /// The region the cells fill when it is not the box (a tube): its signed distance and that
+    /// distance's gradient at `p`.
+    fn cut(&self, p: Vec3) -> Option<(f64, Vec3)>;
+    /// The box around the region.
+    fn bounds(&self) -> Aabb;
+    /// The region's volume, mm³ (the density's base).
+    fn volume(&self) -> f64;
+    /// The shortest cell edge anywhere, mm.
+    fn shortest_edge(&self) -> f64;
+    /// A typical cell's size (for a first level), mm.
+    fn mid_cell(&self) -> Vec3;
+    /// Cells per direction (whole along the mapped ones).
+    fn counts(&self) -> [f64; 3];
+}
+
+impl CellMap for Cylindrical {
+    fn coords(&self, p: Vec3) -> (Vec3, [Vec3; 3]) {
+        Cylindrical::coords(self, p)
+    }
+    fn lipschitz(&self, l: Vec3) -> f64 {
+        Cylindrical::lipschitz(self, l, 0.5 * self.bore)
+    }
+    /// The bound holds beyond half the bore.
+    fn room(&self, p: Vec3) -> f64 {
+        self.radius(p) - 0.5 * self.bore
+    }
+    fn cut(&self, p: Vec3) -> Option<(f64, Vec3)> {
+        Some((self.value(p), self.implicit_with_gradient(p).1))
+    }
+    fn bounds(&self) -> Aabb {
+        Cylindrical::bounds(self)
+    }
+    fn volume(&self) -> f64 {
+        Cylindrical::volume(self)
+    }
+    fn shortest_edge(&self) -> f64 {
+        Cylindrical::shortest_edge(self)
+    }
+    fn mid_cell(&self) -> Vec3 {
+        Cylindrical::mid_cell(self)
+    }
+    fn counts(&self) -> [f64; 3] {
+        self.cells.map(f64::from)
+    }
+}
+
+/// A box whose cells grow linearly along one axis (and keep their size along the others).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct GradedCells {
+    /// The box; cells start at its lower corner.
+    #[serde(rename = "box")]
+    pub bounds: Aabb,
+    /// The graded axis: 0, 1 or 2.
+    pub axis: usize,
+    /// The cell size along the graded axis at its two ends (scaled from those asked for so
+    /// that whole cells span the box), mm.
+    pub ends: [f64; 2],
+    /// Whole cells along the graded axis.
+    pub count: u32,
+    /// Cell size along each axis (the graded axis' entry unused), mm.
+    pub cell: Vec3,
+}
+
+impl GradedCells {
+    /// Cells of `cell` in `bounds`, their size along `axis` growing from `a` to `b` (scaled so
+    /// that whole cells span the box: the count is the nearest to what `a` → `b` would hold).
+    pub fn new(bounds: Aabb, axis: usize, a: f64, b: f64, cell: Vec3) -> Result<GradedCells> {
+        if !(a > 0.0 && b > 0.0 && a.is_finite() && b.is_finite()) {
+            return Err(Error::invalid(format!(
+                "cell sizes of a grade must be positive lengths in mm, got {a} and {b}"
+            )));
+        }
+        let l = bounds.size()[axis];
+        // Cells that sizes a → b hold over the length: ∫dx/s.
+        let held = |a: f64, b: f64| {
+            if (b - a).abs() <= 1e-12 * a {
+                l / a
+            } else {
+                l * (b / a).ln() / (b - a)
+            }
+        };
+        let count = held(a, b).round().max(1.0);
+        if count > 1e6 {
+            return Err(Error::invalid(
+                "the cell-size grade makes over a million cells",
+            ));
+        }
+        let k = held(a, b) / count;
+        Ok(GradedCells {
+            bounds,
+            axis,
+            ends: [a * k, b * k],
+            count: count as u32,
+            cell,
+        })
+    }
+
+    /// The cell size along the graded axis at `x` along it from the box's face (held at the
+    /// ends' sizes beyond them), mm.
+    fn size_at(&self, x: f64) -> f64 {
+        let l = self.bounds.size()[self.axis];
+        let [a, b] = self.ends;
+        a + (b - a) * (x / l).clamp(0.0, 1.0)
+    }
+
+    /// Cell coordinate along the graded axis at `x` from the box's face: `∫dx/s`, extended
+    /// beyond the box at the ends' sizes.
+    fn along(&self, x: f64) -> f64 {
+        let l = self.bounds.size()[self.axis];
+        let [a, b] = self.ends;
+        let inside = |x: f64| {
+            if (b - a).abs() <= 1e-12 * a {
+                x / a
+            } else {
+                l / (b - a) * (self.size_at(x) / a).ln()
+            }
+        };
+        if x < 0.0 {
+            x / a
+        } else if x > l {
+            inside(l) + (x - l) / b
+        } else {
+            inside(x)
+        }
+    }
+
+    /// The cells' faces along the graded axis, from the box's lower face to its upper one, mm.
+    pub fn faces(&self) -> Vec<f64> {
+        let l = self.bounds.size()[self.axis];
+        let [a, b] = self.ends;
+        let lo = self.bounds.min[self.axis];
+        (0..=self.count)
+            .map(|i| {
+                let u = i as f64;
+                if i == self.count {
+                    lo + l
+                } else if (b - a).abs() <= 1e-12 * a {
+                    lo + u * a
+                } else {
+                    lo + (a * (u * (b - a) / l).exp() - a) * l / (b - a)
+                }
+            })
+            .collect()
+    }
+}
+
+impl CellMap for GradedCells {
+    fn coords(&self, p: Vec3) -> (Vec3, [Vec3; 3]) {
+        let mut u = [0.0; 3];
+        let mut j = [[0.0; 3]; 3];
+        for a in 0..3 {
+            let x = p[a] - self.bounds.min[a];
+            if a == self.axis {
+                u[a] = self.along(x);
+                j[a][a] = 1.0 / self.size_at(x);
+            } else {
+                u[a] = x / self.cell[a];
+                j[a][a] = 1.0 / self.cell[a];
+            }
+        }
+        (u, j)
+    }
+    fn lipschitz(&self, l: Vec3) -> f64 {
+        let s = self.shortest_edge_along();
+        (0..3)
+            .map(|a| {
+                let c = if a == self.axis { s } else { self.cell[a] };
+                (l[a] / c).powi(2)
+            })
+            .sum::<f64>()
+            .sqrt()
+    }
+    fn room(&self, _p: Vec3) -> f64 {
+        f64::INFINITY
+    }
+    fn cut(&self, _p: Vec3) -> Option<(f64, Vec3)> {
+        None
+    }
+    fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+    fn volume(&self) -> f64 {
+        self.bounds.volume()
+    }
+    fn shortest_edge(&self) -> f64 {
+        (0..3)
+            .map(|a| {
+                if a == self.axis {
+                    self.shortest_edge_along()
+                } else {
+                    self.cell[a]
+                }
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+    fn mid_cell(&self) -> Vec3 {
+        let mut c = self.cell;
+        c[self.axis] = 0.5 * (self.ends[0] + self.ends[1]);
+        c
+    }
+    fn counts(&self) -> [f64; 3] {
+        let size = self.bounds.size();
+        [0, 1, 2].map(|a| {
+            if a == self.axis {
+                self.count as f64
+            } else {
+                size[a] / self.cell[a]
+            }
+        })
+    }
+}
+
+impl GradedCells {
+    fn shortest_edge_along(&self) -> f64 {
+        self.ends[0].min(self.ends[1])
+    }
+}
 
 /// Cells wrapped around an axis.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -255,6 +495,33 @@ mod tests {
         let above = t.coords([1.0 - 7.0, -2.0 + 1e-9, 5.0]).0[0];
         let below = t.coords([1.0 - 7.0, -2.0 - 1e-9, 5.0]).0[0];
         assert!((above - below - 12.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn graded_cells_are_whole_and_their_faces_are_whole_cell_coordinates() {
+        let b = Aabb {
+            min: [1.0, -2.0, 0.5],
+            max: [31.0, 8.0, 10.5],
+        };
+        let g = GradedCells::new(b, 0, 2.0, 6.0, [5.0; 3]).unwrap();
+        // 30·ln 3/4 = 8.24 cells: 8, the sizes scaled up.
+        assert_eq!(g.count, 8);
+        let faces = g.faces();
+        assert_eq!(faces.len(), 9);
+        for (i, x) in faces.iter().enumerate() {
+            let (u, _) = g.coords([*x, 0.0, 0.0]);
+            assert!((u[0] - i as f64).abs() < 1e-9, "{i}: {u:?}");
+        }
+        let widths: Vec<f64> = faces.windows(2).map(|w| w[1] - w[0]).collect();
+        assert!(widths.windows(2).all(|w| w[1] > w[0]), "{widths:?}");
+        let p = [12.0, 3.0, 4.0];
+        let (_, j) = g.coords(p);
+        for (a, row) in j.iter().enumerate() {
+            let d = crate::field::numeric_gradient(|q| g.coords(q).0[a], p);
+            for (x, y) in d.iter().zip(row) {
+                assert!((x - y).abs() < 1e-6, "{a}: {d:?} {row:?}");
+            }
+        }
     }
 
     #[test]

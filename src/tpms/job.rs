@@ -55,8 +55,8 @@ pub struct TpmsJob {
     pub grading: Option<crate::mesh::graded::Grading>,
     /// A second type blended in by a weight that varies through the part.
     pub blend: Option<super::blend::Blend>,
-    /// Cells wrapped around an axis (the domain's box is then not used).
-    pub cell_map: Option<crate::field::cellmap::Cylindrical>,
+    /// Cells wrapped around an axis (the domain's box is then not used) or growing along one.
+    pub cell_map: Option<crate::field::cellmap::Mapping>,
 }
 
 /// The JSON report of a TPMS job.

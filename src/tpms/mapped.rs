@@ -1,5 +1,5 @@
-//! TPMS lattices on a conformal cell map: cells wrapped around an axis
-//! ([`crate::field::cellmap`]), the lattice `F(u(p))` cut by the tube. The part goes through the
+//! TPMS lattices on a cell map ([`crate::field::cellmap`]): cells wrapped around an axis (the
+//! lattice `F(u(p))` cut by the tube) or growing along one axis of a box. The part goes through the
 //! one pipeline ([`crate::mesh::pipeline`]): meshed whole (or in tiles), its level found on the
 //! part itself against the tube's volume.
 //!
@@ -7,13 +7,14 @@
 //! every other under a turn about the axis or a shift along it, so the part's density is each
 //! cell's. With several cells through the wall the map's Jacobian (∝ r) weighs the layers
 //! differently: the density of each layer is measured on the mesh (the solid within each radius,
-//! by the divergence theorem) and reported.
+//! by the divergence theorem) and reported. Cells that grow along an axis are stretched unevenly
+//! within each cell; the level is found on the part against its box.
 
 use super::calibrate::{self, Connectivity};
 use super::job::TpmsJob;
 use super::{Structure, Surface, TpmsField, TpmsReport};
 use crate::error::{Error, Result};
-use crate::field::cellmap::Cylindrical;
+use crate::field::cellmap::{CellMap, Cylindrical, GradedCells, Mapping};
 use crate::field::{intersection_clearance, Aabb, Field, Vec3};
 use crate::grid::GridSpec;
 use crate::io::sink::{MeshSink, Triangle};
@@ -23,30 +24,31 @@ use crate::mesh::resolution;
 use crate::progress::Progress;
 use std::time::Instant;
 
-/// A TPMS lattice wrapped around an axis and cut by its tube, at one level.
+/// A TPMS lattice on a cell map (cut by its region), at one level.
 #[derive(Debug, Clone, Copy)]
-pub struct MappedLattice {
+pub struct MappedLattice<M> {
     /// Which minimal surface.
     pub surface: Surface,
     /// Net, sheet or the other labyrinth.
     pub structure: Structure,
     /// The level `t`.
     pub level: f64,
-    /// The cell map (and the tube it fills).
-    pub map: Cylindrical,
+    /// The cell map (and the region it fills).
+    pub map: M,
 }
 
-/// The mapped lattice's field: the first-order distance `(F∘u − t)/|∇(F∘u)|` cut by the tube.
-struct MappedField {
+/// The mapped lattice's field: the first-order distance `(F∘u − t)/|∇(F∘u)|`, cut by the map's
+/// region where it is not the box.
+struct MappedField<M> {
     /// The surface with unit cells at the origin: `distance_at` and `implicit_at` in cell
     /// coordinates.
     tpms: TpmsField,
-    map: Cylindrical,
-    /// `|∇(F∘u)|` bound at half the bore and beyond.
+    map: M,
+    /// `|∇(F∘u)|` bound (within the map's room of a point).
     lipschitz: f64,
 }
 
-impl MappedField {
+impl<M: CellMap> MappedField<M> {
     /// `F`, the implicit function and its gradient in world coordinates.
     #[inline(always)]
     fn eval(&self, p: Vec3) -> (f64, f64, Vec3) {
@@ -56,10 +58,10 @@ impl MappedField {
         (f, self.tpms.implicit_at(f, self.tpms.level), gw)
     }
 
-    /// The lattice's clearance: its implicit value over the gradient bound, within a ball that
-    /// keeps out of the inner half of the bore (where the bound no longer holds).
+    /// The lattice's clearance: its implicit value over the gradient bound, within the ball
+    /// where the bound holds (out of the inner half of a tube's bore).
     fn lattice_clearance(&self, p: Vec3, implicit: f64) -> f64 {
-        let room = self.map.radius(p) - 0.5 * self.map.bore;
+        let room = self.map.room(p);
         if room <= 0.0 {
             return 0.0;
         }
@@ -67,7 +69,7 @@ impl MappedField {
     }
 }
 
-impl Field for MappedField {
+impl<M: CellMap> Field for MappedField<M> {
     fn value(&self, p: Vec3) -> f64 {
         self.value_and_clearance(p).0
     }
@@ -80,9 +82,13 @@ impl Field for MappedField {
         let (f, v, g) = self.eval(p);
         let a = self.tpms.distance_at(f, g, self.tpms.level);
         let ca = self.lattice_clearance(p, v);
-        let b = self.map.value(p).clamp(-self.tpms.clamp, self.tpms.clamp);
-        let cb = self.map.value(p).abs();
-        (a.max(b), intersection_clearance(a, ca, b, cb))
+        match self.map.cut(p) {
+            None => (a, ca),
+            Some((b, _)) => (
+                a.max(b.clamp(-self.tpms.clamp, self.tpms.clamp)),
+                intersection_clearance(a, ca, b, b.abs()),
+            ),
+        }
     }
 
     fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
@@ -94,17 +100,15 @@ impl Field for MappedField {
         };
         let g = g.map(|x| sign * x);
         let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt().max(1e-12);
-        let (b, gb) = self.map.implicit_with_gradient(p);
         // Whichever of the two solids is the boundary here, in the same (distance) units.
-        if b > v / n {
-            (b, gb)
-        } else {
-            (v / n, g.map(|x| x / n))
+        match self.map.cut(p) {
+            Some((b, gb)) if b > v / n => (b, gb),
+            _ => (v / n, g.map(|x| x / n)),
         }
     }
 }
 
-impl Solid for MappedLattice {
+impl<M: CellMap> Solid for MappedLattice<M> {
     fn field(&self, spec: &GridSpec) -> Box<dyn Field + '_> {
         let tpms = TpmsField::new(
             self.surface,
@@ -117,9 +121,7 @@ impl Solid for MappedLattice {
         Box::new(MappedField {
             tpms,
             map: self.map,
-            lipschitz: self
-                .map
-                .lipschitz(self.surface.lipschitz_per_axis(), 0.5 * self.map.bore),
+            lipschitz: self.map.lipschitz(self.surface.lipschitz_per_axis()),
         })
     }
 
@@ -137,17 +139,17 @@ impl Solid for MappedLattice {
     }
 }
 
-/// The mapped lattice at every level; its density is its share of the tube.
+/// The mapped lattice at every level; its density is its share of the map's region.
 #[derive(Debug, Clone, Copy)]
-pub struct MappedFamily {
+pub struct MappedFamily<M> {
     /// The part at some level (replaced).
-    pub part: MappedLattice,
+    pub part: MappedLattice<M>,
 }
 
-impl Family for MappedFamily {
-    type Solid = MappedLattice;
+impl<M: CellMap> Family for MappedFamily<M> {
+    type Solid = MappedLattice<M>;
 
-    fn at(&self, level: f64) -> MappedLattice {
+    fn at(&self, level: f64) -> MappedLattice<M> {
         MappedLattice { level, ..self.part }
     }
 
@@ -160,56 +162,110 @@ impl Family for MappedFamily {
     }
 
     fn fraction(&self, volume: f64, _bounds: &Aabb) -> f64 {
-        volume / self.part.map.volume()
+        volume / CellMap::volume(&self.part.map)
     }
 }
 
-/// The tube and how its layers met the density.
+/// The cell map, and how a tube's layers met the density.
 #[derive(Debug, Clone, serde::Serialize)]
-pub struct CellMapReport {
-    /// `cylindrical`.
-    pub kind: &'static str,
-    /// The map: axis, bore, cells, sizes.
-    #[serde(flatten)]
-    pub map: Cylindrical,
-    /// Outer radius, mm.
-    pub outer_radius: f64,
-    /// Length along the axis, mm.
-    pub length: f64,
-    /// The tube's volume, mm³ (the density's base).
-    pub tube_volume: f64,
-    /// The density of each layer of cells through the wall, bore outwards, measured on the
-    /// written mesh.
-    pub layer_densities: Vec<f64>,
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum CellMapReport {
+    /// Cells wrapped around an axis.
+    Cylindrical {
+        /// The map: axis, bore, cells, sizes.
+        #[serde(flatten)]
+        map: Cylindrical,
+        /// Outer radius, mm.
+        outer_radius: f64,
+        /// Length along the axis, mm.
+        length: f64,
+        /// The tube's volume, mm³ (the density's base).
+        tube_volume: f64,
+        /// The density of each layer of cells through the wall, bore outwards, measured on the
+        /// written mesh.
+        layer_densities: Vec<f64>,
+    },
+    /// Cells growing along an axis.
+    Graded {
+        /// The map: box, axis, end sizes, count.
+        #[serde(flatten)]
+        map: GradedCells,
+        /// The cells' faces along the graded axis, mm.
+        faces: Vec<f64>,
+    },
 }
 
 impl TpmsJob {
-    /// Runs a job on a cylindrical cell map.
+    /// Runs a job on a cell map.
     pub(super) fn run_mapped(
         &self,
-        map: Cylindrical,
+        mapping: Mapping,
+        progress: &Progress,
+        sink: &mut dyn MeshSink,
+    ) -> Result<TpmsReport> {
+        match mapping {
+            Mapping::Cylindrical(map) => {
+                // The layers are measured on the written triangles on their way to the sink.
+                let mut layers = Layers::new(map, sink);
+                let mut report = self.run_on(map, "tube", progress, &mut layers)?;
+                let layer_densities = layers.densities();
+                for (k, d) in layer_densities.iter().enumerate() {
+                    if (d - self.density).abs() > 0.005 {
+                        report.part.warnings.push(format!(
+                            "layer {} of {} through the wall holds {d:.4}, the tube {:.4}: the map's Jacobian weighs the layers differently",
+                            k + 1,
+                            layer_densities.len(),
+                            report.part.achieved_density
+                        ));
+                    }
+                }
+                report.cell_map = Some(CellMapReport::Cylindrical {
+                    map,
+                    outer_radius: map.outer(),
+                    length: map.length(),
+                    tube_volume: map.volume(),
+                    layer_densities,
+                });
+                Ok(report)
+            }
+            Mapping::Graded(map) => {
+                let mut report = self.run_on(map, "part with graded cells", progress, sink)?;
+                report.cell_map = Some(CellMapReport::Graded {
+                    map,
+                    faces: map.faces(),
+                });
+                Ok(report)
+            }
+        }
+    }
+
+    /// Runs a job on the cell map `map` (`what` the part is, for messages).
+    fn run_on<M: CellMap>(
+        &self,
+        map: M,
+        what: &str,
         progress: &Progress,
         sink: &mut dyn MeshSink,
     ) -> Result<TpmsReport> {
         let start = Instant::now();
         if self.grading.is_some() || self.blend.is_some() {
-            return Err(Error::invalid(
-                "--cell-map makes a uniform density: a graded or blended tube is not supported yet",
-            ));
+            return Err(Error::invalid(format!(
+                "a cell map makes a uniform density: a graded or blended {what} is not supported yet"
+            )));
         }
         let (s, st) = (self.surface, self.structure);
         let range = calibrate::feasible(s, st);
         let (conn, mut warnings): (Connectivity, Vec<String>) = self.connectivity(range)?;
         let t0 = calibrate::analytic_level(s, st, self.density);
         let opts = self.options(false, !conn.solid);
-        let request = self.request(format!("the {} {} tube", s.name(), st.name()), t0);
+        let request = self.request(format!("the {} {} {what}", s.name(), st.name()), t0);
         let mut calibrate_seconds = 0.0;
         let mut calibration = None;
         let resolved = resolution::search(&request, &mut |r| {
-            let _p = progress.stage("calibrating and meshing the tube");
+            let _p = progress.stage("calibrating and meshing");
             let voxel = map.shortest_edge() / r as f64;
             let t = Instant::now();
-            // The unit cell at the middle of the wall: a first level.
+            // The unit cell at a typical cell's size: a first level.
             let cal = calibrate::calibrate(
                 s,
                 st,
@@ -246,18 +302,7 @@ impl TpmsJob {
         let (voxel, family, route, solved) = resolved.found;
         let level = solved.best.level;
         let level_search = LevelSearch::new(&solved.best, route, &solved.tried, resolved.coarser);
-        // The layers are measured on the written triangles on their way to the sink.
-        let mut layers = Layers::new(map, sink);
-        let written = pipeline::write(
-            &family,
-            solved.best,
-            voxel,
-            route,
-            &opts,
-            progress,
-            &mut layers,
-        )?;
-        let layer_densities = layers.densities();
+        let written = pipeline::write(&family, solved.best, voxel, route, &opts, progress, sink)?;
         let volume = written.measures.volume;
         let mut part = PartReport::new(
             map.bounds(),
@@ -271,16 +316,6 @@ impl TpmsJob {
             },
         );
         part.density_against(self.density, volume / map.volume());
-        for (k, d) in layer_densities.iter().enumerate() {
-            if (d - self.density).abs() > 0.005 {
-                part.warnings.push(format!(
-                    "layer {} of {} through the wall holds {d:.4}, the tube {:.4}: the map's Jacobian weighs the layers differently",
-                    k + 1,
-                    layer_densities.len(),
-                    volume / map.volume()
-                ));
-            }
-        }
         warnings.append(&mut part.warnings);
         part.warnings = warnings;
         part.timings.total = start.elapsed().as_secs_f64();
@@ -298,17 +333,10 @@ impl TpmsJob {
             thinnest_wall_voxels: (st == Structure::Sheet)
                 .then(|| calibrate::thinnest_sheet_wall(s, t0) * map.shortest_edge() / voxel),
             cell_size: map.mid_cell(),
-            cells: map.cells.map(f64::from),
+            cells: map.counts(),
             grading: None,
             blend: None,
-            cell_map: Some(CellMapReport {
-                kind: "cylindrical",
-                map,
-                outer_radius: map.outer(),
-                length: map.length(),
-                tube_volume: map.volume(),
-                layer_densities,
-            }),
+            cell_map: None,
             part,
         })
     }
