@@ -652,12 +652,22 @@ fn bad_fields_are_refused() {
         (&["--type", "p", "--density-grade", "z:0.1:0.3"], "--clamp"),
         (&["--density-grade", "w:0.1:0.3"], "AXIS:A:B"),
     ];
-    let before = files_in(dir.path());
+    refused(
+        dir.path(),
+        &["tpms", "--cells", "2", "-r", "8", "-o", "x.stl"],
+        &cases,
+    );
+}
+
+/// Each case's options after `prefix`, run in `dir`: refused (one line naming the case's
+/// words, exit 2, no file).
+fn refused(dir: &Path, prefix: &[&str], cases: &[(&[&str], &str)]) {
+    let before = files_in(dir);
     for (extra, what) in cases {
-        let mut args = vec!["tpms", "--cells", "2", "-r", "8", "-o", "x.stl"];
+        let mut args = prefix.to_vec();
         args.extend_from_slice(extra);
-        let out = run(&args, dir.path());
-        assert_refusal(dir.path(), &before, &out, &args, what);
+        let out = run(&args, dir);
+        assert_refusal(dir, &before, &out, &args, what);
     }
 }
 
@@ -1033,13 +1043,7 @@ fn bad_cell_maps_are_refused() {
             "cannot be used with",
         ),
     ];
-    let before = files_in(dir.path());
-    for (extra, what) in cases {
-        let mut args = vec!["tpms", "-r", "8", "-o", "x.stl"];
-        args.extend_from_slice(extra);
-        let out = run(&args, dir.path());
-        assert_refusal(dir.path(), &before, &out, &args, what);
-    }
+    refused(dir.path(), &["tpms", "-r", "8", "-o", "x.stl"], &cases);
 }
 
 /// Cells growing along z from 3 to 8 mm through a 30 mm block (scaled so whole cells span it):
