@@ -48,6 +48,16 @@ fn measure(stl: &Path, origin: [f64; 3], cell: [f64; 3], size: [f64; 3]) -> Meas
     }
 }
 
+/// The report `r` says CGAL checked the part: closed, manifold, outward, no self-intersection.
+fn assert_clean_by_cgal(r: &serde_json::Value, what: &str) {
+    let checks = &r["checks"];
+    assert_eq!(checks["checked_by"], "CGAL", "{what}");
+    for key in ["closed", "manifold", "outward"] {
+        assert_eq!(checks[key], true, "{what}: {key}");
+    }
+    assert_eq!(checks["self_intersecting"], false, "{what}");
+}
+
 /// A graded part made by `args` (without output options), checked against `field` (the
 /// density the user asked for at a point): closed, one component, clean by CGAL, and each
 /// whole cell within ±0.01 of the field at its centre (±0.005 where the field is constant over
@@ -85,12 +95,7 @@ fn check_cells(
     ]);
     ok(&all, dir.path());
     let r = json(&dir.path().join("part.json"));
-    let checks = &r["checks"];
-    assert_eq!(checks["checked_by"], "CGAL", "{args:?}");
-    for key in ["closed", "manifold", "outward"] {
-        assert_eq!(checks[key], true, "{args:?}: {key}");
-    }
-    assert_eq!(checks["self_intersecting"], false, "{args:?}");
+    assert_clean_by_cgal(&r, &format!("{args:?}"));
     assert_eq!(r["grading"]["cells_met"], true, "{args:?}");
     let m = measure(&dir.path().join("part.stl"), origin, cell, size);
     assert_eq!(m.status, "Error.NoError", "{args:?}: manifold3d");
@@ -873,12 +878,7 @@ fn check_tube(
     all.extend_from_slice(args);
     ok(&all, dir.path());
     let r = json(&dir.path().join("tube.json"));
-    let checks = &r["checks"];
-    assert_eq!(checks["checked_by"], "CGAL", "{all:?}");
-    for key in ["closed", "manifold", "outward"] {
-        assert_eq!(checks[key], true, "{all:?}: {key}");
-    }
-    assert_eq!(checks["self_intersecting"], false, "{all:?}");
+    assert_clean_by_cgal(&r, &format!("{all:?}"));
     let m = measure_tube(
         &dir.path().join("tube.stl"),
         &centre_s,
@@ -1079,12 +1079,7 @@ fn cells_growing_along_an_axis_are_whole_and_hold_the_density() {
     ];
     ok(&args, dir.path());
     let r = json(&dir.path().join("g.json"));
-    let checks = &r["checks"];
-    assert_eq!(checks["checked_by"], "CGAL");
-    for key in ["closed", "manifold", "outward"] {
-        assert_eq!(checks[key], true, "{key}");
-    }
-    assert_eq!(checks["self_intersecting"], false);
+    assert_clean_by_cgal(&r, "grown cells");
     let map = &r["cell_map"];
     assert_eq!(map["kind"], "graded");
     let faces: Vec<f64> = map["faces"]
