@@ -33,6 +33,7 @@ const PART_KEYS: &[(&str, &[&str])] = &[
             "blend-field",
             "cell-map",
             "bore",
+            "layers",
             "cell-size-grade",
             "allow-islands",
         ],

@@ -51,6 +51,10 @@ Examples:
   # through the 4 mm wall, 4 along; whole cells around, every cell at 30 %
   latvox tpms --type gyroid --cell-map cylindrical --bore 10 --cells 12,1,4 --cell-size 4 -o tube.stl
 
+  # A spherical shell (a cubed sphere: six faces of 4×4 cells, no poles) around a 12 mm bore,
+  # two cells through the wall, every cell whole
+  latvox tpms --type d --density 0.25 --cell-map spherical --bore 12 --cells 4 --layers 2 -o ball.stl
+
   # Cells 3 mm at the bottom of a 40 mm block growing to 8 mm at its top, each one whole
   latvox tpms --type gyroid --size 20,20,40 --cell-size 5 --cell-size-grade z:3:8 -o grown.stl
 
@@ -98,18 +102,25 @@ pub struct TpmsArgs {
         allow_hyphen_values = true
     )]
     pub blend_field: Option<String>,
-    /// Wrap the cells around the z axis through --origin (a tube, its lower end at --origin):
-    /// --cells gives the cells around, through the wall and along the axis (12,1,4 by default),
-    /// --cell-size the cell's size through the wall and along the axis (5 mm by default), --bore
-    /// the inner radius. Whole cells around: no cell is cut at the seam.
-    #[arg(long, value_name = "cylindrical", value_parser = ["cylindrical"], requires = "bore")]
+    /// Wrap the cells around an axis or a centre. cylindrical: a tube about the z axis through
+    /// --origin (its lower end's centre); --cells gives the cells around, through the wall and
+    /// along the axis (12,1,4 by default), --cell-size the cell's size through the wall and
+    /// along the axis (5 mm by default), --bore the inner radius; whole cells around, none cut at
+    /// the seam. spherical: a shell about --origin made of a cube's six faces (a cubed sphere,
+    /// no poles); --cells N gives the cells along each face's edge at the bore (4 by default),
+    /// --layers the cells through the wall (1), --cell-size the cell's size through the wall
+    /// (by default πR/2N, cubes at the faces' middles); every cell whole.
+    #[arg(long, value_name = "cylindrical|spherical", value_parser = ["cylindrical", "spherical"], requires = "bore")]
     pub cell_map: Option<String>,
+    /// Cells through the wall of a --cell-map spherical shell (1 by default).
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub layers: Option<u32>,
     /// Grade the cell size along an axis: AXIS:A:B, cells A mm at the box's lower face growing
     /// to B mm at its upper one (as z:3:6), scaled a little so that whole cells span the box
     /// (the cell size along the other axes from --cell-size); no cell is torn.
     #[arg(long, value_name = "AXIS:A:B", conflicts_with = "cell_map")]
     pub cell_size_grade: Option<String>,
-    /// Inner radius of a --cell-map tube, mm.
+    /// Inner radius of a --cell-map tube or shell, mm.
     #[arg(
         long,
         value_name = "MM",
@@ -189,26 +200,59 @@ impl TpmsArgs {
             return GradedCells::new(d.bounds(), axis, a, b, d.cell)
                 .map(|m| Some(Mapping::Graded(m)));
         }
-        let (Some(_), Some(bore)) = (&self.cell_map, self.bore) else {
+        let (Some(kind), Some(bore)) = (&self.cell_map, self.bore) else {
+            if self.layers.is_some() {
+                return Err(latvox::Error::invalid(
+                    "--layers counts the cells through a --cell-map spherical shell's wall",
+                ));
+            }
             return Ok(None);
         };
         let d = &self.domain;
         if d.size.is_some() {
+            return Err(latvox::Error::invalid(format!(
+                "--cell-map makes a {} from --cells, --cell-size and --bore: --size is not used",
+                if kind == "spherical" { "shell" } else { "tube" }
+            )));
+        }
+        let one_size = |default: Option<f64>, what: &str| match d.cell_size {
+            None => Ok(default),
+            Some([a, b, c]) if a == b && b == c => Ok(Some(a)),
+            Some(_) => Err(latvox::Error::invalid(format!(
+                "with --cell-map, --cell-size is one size ({what})"
+            ))),
+        };
+        if kind == "spherical" {
+            let n = match d.cells {
+                None => 4,
+                Some([a, b, c]) if a == b && b == c => a,
+                Some(_) => {
+                    return Err(latvox::Error::invalid(
+                        "a spherical shell's --cells is one count, the cells along each face's edge at the bore (--layers counts those through the wall)",
+                    ))
+                }
+            };
+            let cell = one_size(None, "through the wall")?;
+            return latvox::field::cellmap::Spherical::new(
+                d.origin,
+                bore,
+                [n, self.layers.unwrap_or(1)],
+                cell,
+            )
+            .map(|m| Some(Mapping::Spherical(m)));
+        }
+        if self.layers.is_some() {
             return Err(latvox::Error::invalid(
-                "--cell-map makes a tube from --cells, --cell-size and --bore: --size is not used",
+                "a tube's layers are the second of --cells (around, through, along); --layers is for a spherical shell",
             ));
         }
         let cells = d.cells.unwrap_or([12, 1, 4]);
-        let cell = match d.cell_size {
-            None => [5.0, 5.0],
-            Some([a, b, c]) if a == b && b == c => [a, a],
-            Some(_) => {
-                return Err(latvox::Error::invalid(
-                    "with --cell-map, --cell-size is one size (through the wall and along the axis); the cells around follow from --cells and --bore",
-                ))
-            }
-        };
-        latvox::field::cellmap::Cylindrical::new(d.origin, bore, cells, cell)
+        let a = one_size(
+            Some(5.0),
+            "through the wall and along the axis; the cells around follow from --cells and --bore",
+        )?
+        .unwrap_or(5.0);
+        latvox::field::cellmap::Cylindrical::new(d.origin, bore, cells, [a, a])
             .map(|m| Some(Mapping::Cylindrical(m)))
     }
 
@@ -281,6 +325,23 @@ fn print_tpms_summary(r: &TpmsReport) {
             ),
             format!("{cells} (around × through × along)"),
         ),
+        Some(CellMapReport::Spherical {
+            map,
+            outer_radius,
+            total_cells,
+            ..
+        }) => (
+            format!(
+                "{blend} spherical shell, bore {} mm, outer radius {} mm",
+                human(map.bore, 4),
+                human(*outer_radius, 4)
+            ),
+            format!(
+                "{total_cells} ({n}×{n} on each of 6 faces at the bore, {} through)",
+                map.cells[1],
+                n = map.cells[0]
+            ),
+        ),
         Some(CellMapReport::Graded { map, .. }) => (
             format!(
                 "{blend}, cells growing along {} from {} to {} mm",
@@ -313,10 +374,16 @@ fn print_tpms_summary(r: &TpmsReport) {
         p.density_error.unwrap_or(f64::NAN),
         r.level
     );
-    if let Some(CellMapReport::Cylindrical {
-        layer_densities, ..
-    }) = r.cell_map.as_ref().filter(|_| r.cells[1] > 1.0)
-    {
+    let layer_densities = match &r.cell_map {
+        Some(CellMapReport::Cylindrical {
+            layer_densities, ..
+        })
+        | Some(CellMapReport::Spherical {
+            layer_densities, ..
+        }) => Some(layer_densities).filter(|l| l.len() > 1),
+        _ => None,
+    };
+    if let Some(layer_densities) = layer_densities {
         let layers: Vec<String> = layer_densities.iter().map(|d| format!("{d:.4}")).collect();
         outln!("layers    {} (bore outwards)", layers.join("  "));
     }

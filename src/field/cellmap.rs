@@ -13,6 +13,9 @@
 //! along the axis. The map is smooth and one-to-one on the wall, so the solid keeps the
 //! topology of a box of cells joined around: what holds together in a box holds together here.
 //!
+//! The spherical map ([`Spherical`]) wraps cells around a centre as a cubed sphere: six faces of
+//! `N × N` cells at the bore, every cell whole, no poles.
+//!
 //! The graded map ([`GradedCells`]) keeps a box but lets the cell size grow linearly along one
 //! axis, `s(x) = a + (b − a)·x/L`: `u = ∫dx/s = L/(b − a)·ln(s(x)/a)`, its ends scaled so that a
 //! whole number of cells spans the box (cells are not torn: each is the image of a unit cell).
@@ -21,6 +24,9 @@ use super::{Aabb, Field, Vec3};
 use crate::error::{Error, Result};
 use std::f64::consts::TAU;
 
+/// 4/π: an equiangular face's angle (±π/4) to its cell coordinate (±1).
+const FRAC_4_PI: f64 = 4.0 / std::f64::consts::PI;
+
 /// The cell maps a part can be made on.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Mapping {
@@ -28,6 +34,8 @@ pub enum Mapping {
     Cylindrical(Cylindrical),
     /// Cells growing along an axis of a box.
     Graded(GradedCells),
+    /// Cells wrapped around a centre.
+    Spherical(Spherical),
 }
 
 /// A map from space to cell coordinates, and the region its cells fill.
@@ -378,54 +386,113 @@ impl Cylindrical {
 
     /// The volume of a closed outward mesh's solid within radius `radius` of the axis, mm³, by the
     /// divergence theorem with the field `V = ½(x, y, 0)·min(1, R²/r²)` (divergence 1 within
-    /// the radius, 0 beyond it, continuous across it), integrated over each triangle by its edge
-    /// midpoints (exact where V is linear; the triangles the cylinder crosses, and those
-    /// larger than a quarter of the radius, are split in four first).
+    /// the radius, 0 beyond it, continuous across it).
     pub fn volume_within(&self, triangles: impl Iterator<Item = [Vec3; 3]>, radius: f64) -> f64 {
         let c = self.centre;
         let v = |p: Vec3| {
             let (x, y) = (p[0] - c[0], p[1] - c[1]);
             let s = 0.5 * (radius * radius / (x * x + y * y).max(1e-300)).min(1.0);
-            [s * x, s * y]
+            [s * x, s * y, 0.0]
         };
-        fn flux(
-            t: [Vec3; 3],
-            v: &dyn Fn(Vec3) -> [f64; 2],
-            depth: u32,
-            radius: f64,
-            c: Vec3,
-        ) -> f64 {
-            let [a, b, d] = t;
-            let r = |p: Vec3| (p[0] - c[0]).hypot(p[1] - c[1]);
-            let rs = [r(a), r(b), r(d)];
-            let crosses = rs.iter().any(|&x| x < radius) && rs.iter().any(|&x| x > radius);
-            let edge = |p: Vec3, q: Vec3| (p[0] - q[0]).hypot(p[1] - q[1]);
-            // Beyond the radius V bends: large triangles there are split too.
-            let large = edge(a, b).max(edge(b, d)).max(edge(d, a)) > 0.25 * radius;
-            let mid = |p: Vec3, q: Vec3| [0, 1, 2].map(|i| 0.5 * (p[i] + q[i]));
-            let (ab, bd, da) = (mid(a, b), mid(b, d), mid(d, a));
-            if (crosses || large) && depth > 0 {
-                return [[a, ab, da], [ab, b, bd], [da, bd, d], [ab, bd, da]]
-                    .into_iter()
-                    .map(|t| flux(t, v, depth - 1, radius, c))
-                    .sum();
-            }
-            // ½ (b − a) × (d − a): the area vector; only its x and y matter.
-            let (e, f) = (
-                [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
-                [d[0] - a[0], d[1] - a[1], d[2] - a[2]],
-            );
-            let n = [
-                0.5 * (e[1] * f[2] - e[2] * f[1]),
-                0.5 * (e[2] * f[0] - e[0] * f[2]),
-            ];
-            let mean = [ab, bd, da].iter().fold([0.0; 2], |m, p| {
-                let w = v(*p);
-                [m[0] + w[0] / 3.0, m[1] + w[1] / 3.0]
-            });
-            mean[0] * n[0] + mean[1] * n[1]
+        flux_within(triangles, radius, &|p| self.radius(p), &v)
+    }
+}
+
+/// The flux of `v` out of a closed outward mesh, where `v`'s divergence is 1 within `radius`
+/// (as `dist` measures it) and 0 beyond, continuous across: the solid's volume within the
+/// radius, mm³. Each triangle is integrated by its edge midpoints (exact where `v` is linear);
+/// those the radius crosses, and those longer than a quarter of it (`v` bends beyond it), are
+/// split in four first, up to six times.
+fn flux_within(
+    triangles: impl Iterator<Item = [Vec3; 3]>,
+    radius: f64,
+    dist: &dyn Fn(Vec3) -> f64,
+    v: &dyn Fn(Vec3) -> Vec3,
+) -> f64 {
+    fn flux(
+        t: [Vec3; 3],
+        depth: u32,
+        radius: f64,
+        dist: &dyn Fn(Vec3) -> f64,
+        v: &dyn Fn(Vec3) -> Vec3,
+    ) -> f64 {
+        let [a, b, d] = t;
+        let rs = [dist(a), dist(b), dist(d)];
+        let crosses = rs.iter().any(|&x| x < radius) && rs.iter().any(|&x| x > radius);
+        let sub = |p: Vec3, q: Vec3| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+        let len = |e: Vec3| (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+        let large = len(sub(a, b)).max(len(sub(b, d))).max(len(sub(d, a))) > 0.25 * radius;
+        let mid = |p: Vec3, q: Vec3| [0, 1, 2].map(|i| 0.5 * (p[i] + q[i]));
+        let (ab, bd, da) = (mid(a, b), mid(b, d), mid(d, a));
+        if (crosses || large) && depth > 0 {
+            return [[a, ab, da], [ab, b, bd], [da, bd, d], [ab, bd, da]]
+                .into_iter()
+                .map(|t| flux(t, depth - 1, radius, dist, v))
+                .sum();
         }
-        triangles.map(|t| flux(t, &v, 6, radius, c)).sum()
+        // ½ (b − a) × (d − a): the area vector.
+        let (e, f) = (sub(b, a), sub(d, a));
+        let n = [
+            0.5 * (e[1] * f[2] - e[2] * f[1]),
+            0.5 * (e[2] * f[0] - e[0] * f[2]),
+            0.5 * (e[0] * f[1] - e[1] * f[0]),
+        ];
+        [ab, bd, da]
+            .iter()
+            .map(|p| {
+                let w = v(*p);
+                (w[0] * n[0] + w[1] * n[1] + w[2] * n[2]) / 3.0
+            })
+            .sum()
+    }
+    triangles.map(|t| flux(t, 6, radius, dist, v)).sum()
+}
+
+/// Maps whose cells lie in layers between radii (a tube's wall, a shell's): the density of each
+/// layer is measured on the closed mesh, the solid within each radius by the divergence
+/// theorem.
+pub trait Layered: CellMap {
+    /// The radii between layers, bore outwards (one more than the layers).
+    fn layer_radii(&self) -> Vec<f64>;
+    /// The volume of the map's region between radii `r0` and `r1`, mm³.
+    fn region_between(&self, r0: f64, r1: f64) -> f64;
+    /// The volume of a closed outward mesh's solid within `radius`, mm³.
+    fn volume_within(&self, triangles: &mut dyn Iterator<Item = [Vec3; 3]>, radius: f64) -> f64;
+}
+
+impl Layered for Cylindrical {
+    fn layer_radii(&self) -> Vec<f64> {
+        (0..=self.cells[1])
+            .map(|k| self.bore + k as f64 * self.cell[0])
+            .collect()
+    }
+    fn region_between(&self, r0: f64, r1: f64) -> f64 {
+        std::f64::consts::PI * (r1 * r1 - r0 * r0) * self.length()
+    }
+    fn volume_within(&self, triangles: &mut dyn Iterator<Item = [Vec3; 3]>, radius: f64) -> f64 {
+        Cylindrical::volume_within(self, triangles, radius)
+    }
+}
+
+impl Layered for Spherical {
+    fn layer_radii(&self) -> Vec<f64> {
+        (0..=self.cells[1])
+            .map(|k| self.bore + k as f64 * self.cell)
+            .collect()
+    }
+    fn region_between(&self, r0: f64, r1: f64) -> f64 {
+        4.0 / 3.0 * std::f64::consts::PI * (r1.powi(3) - r0.powi(3))
+    }
+    /// With `V = (d/3)·min(1, R³/|d|³)`.
+    fn volume_within(&self, triangles: &mut dyn Iterator<Item = [Vec3; 3]>, radius: f64) -> f64 {
+        let c = self.centre;
+        let v = |p: Vec3| {
+            let d = [0, 1, 2].map(|i| p[i] - c[i]);
+            let r2 = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).max(1e-300);
+            let s = (radius.powi(3) / (r2 * r2.sqrt())).min(1.0) / 3.0;
+            d.map(|x| s * x)
+        };
+        flux_within(triangles, radius, &|p| self.radius(p), &v)
     }
 }
 
@@ -470,9 +537,243 @@ impl Field for Cylindrical {
     }
 }
 
+/// Cells wrapped around a centre: a spherical shell made of the six faces of a cube (a cubed
+/// sphere, equiangular), so that no cell shrinks to a point (a latitude–longitude map has poles).
+///
+/// With `d = p − c`, `m = |d|∞`, `h = N/2 + (|d| − R)/a`:
+///
+/// ```text
+/// u_i = h·(4/π)·atan(d_i/m) + N/2
+/// ```
+///
+/// takes the sphere of radius `|d|` onto the surface of a cube of half-side `h` (each face
+/// equiangular), so the shell `R ≤ |d| ≤ R + K·a` is the image of the cubic shell
+/// `[−K, N + K]³ ∖ (0, N)³` of cell coordinates: `(N + 2K)³ − N³` whole cells, `N × N` on each
+/// face at the bore, `K` through the wall. The map is continuous everywhere and smooth but for
+/// a crease along the cube's edges (where two faces meet, its derivative turns).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Spherical {
+    /// The shell's centre, mm.
+    pub centre: Vec3,
+    /// Inner radius, mm.
+    pub bore: f64,
+    /// Cells along each edge of the cube's faces at the bore, and cells through the wall.
+    pub cells: [u32; 2],
+    /// Cell size through the wall, mm.
+    pub cell: f64,
+}
+
+impl Spherical {
+    /// A shell of `cells` (per face edge at the bore, through the wall), its cells `cell` mm
+    /// through the wall (by default the size that makes the bore's cells cubes at the faces'
+    /// middles, `πR/2N`), its inner radius `bore` mm, about `centre`.
+    pub fn new(centre: Vec3, bore: f64, cells: [u32; 2], cell: Option<f64>) -> Result<Spherical> {
+        if !(bore > 0.0 && bore.is_finite()) {
+            return Err(Error::invalid(format!(
+                "--bore must be a positive radius in mm, got {bore}"
+            )));
+        }
+        if cells.contains(&0) {
+            return Err(Error::invalid("cell counts must be at least 1"));
+        }
+        if cells[0] > 4096 || cells[1] > 4096 {
+            return Err(Error::invalid(format!(
+                "a spherical shell of {} × {} cells per face and {} through is too many",
+                cells[0], cells[0], cells[1]
+            )));
+        }
+        let cell = cell.unwrap_or(std::f64::consts::FRAC_PI_2 * bore / cells[0] as f64);
+        if !(cell > 0.0 && cell.is_finite()) || !centre.iter().all(|c| c.is_finite()) {
+            return Err(Error::invalid(
+                "the cell size must be positive and the origin finite",
+            ));
+        }
+        Ok(Spherical {
+            centre,
+            bore,
+            cells,
+            cell,
+        })
+    }
+
+    /// Outer radius, mm.
+    pub fn outer(&self) -> f64 {
+        self.bore + self.cells[1] as f64 * self.cell
+    }
+
+    /// Every cell of the shell: `(N + 2K)³ − N³`.
+    pub fn total(&self) -> u64 {
+        let [n, k] = self.cells.map(u64::from);
+        (n + 2 * k).pow(3) - n.pow(3)
+    }
+
+    /// The shell's volume, mm³.
+    pub fn volume(&self) -> f64 {
+        4.0 / 3.0 * std::f64::consts::PI * (self.outer().powi(3) - self.bore.powi(3))
+    }
+
+    /// Distance from the centre, mm.
+    pub fn radius(&self, p: Vec3) -> f64 {
+        let d = [0, 1, 2].map(|i| p[i] - self.centre[i]);
+        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+    }
+
+    /// The half-side of the cube of cell coordinates at radius `r`.
+    fn half_side(&self, r: f64) -> f64 {
+        0.5 * self.cells[0] as f64 + (r - self.bore) / self.cell
+    }
+
+    /// Cell coordinates of `p`, and the gradient of each (the rows of the Jacobian), per mm.
+    #[inline(always)]
+    pub fn coords(&self, p: Vec3) -> (Vec3, [Vec3; 3]) {
+        let d = [0, 1, 2].map(|i| p[i] - self.centre[i]);
+        let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(1e-300);
+        let k = if d[0].abs() >= d[1].abs() && d[0].abs() >= d[2].abs() {
+            0
+        } else if d[1].abs() >= d[2].abs() {
+            1
+        } else {
+            2
+        };
+        let m = d[k].abs().max(1e-300);
+        let sk = d[k].signum();
+        let h = self.half_side(r);
+        let half = 0.5 * self.cells[0] as f64;
+        let mut u = [0.0; 3];
+        let mut jac = [[0.0; 3]; 3];
+        for i in 0..3 {
+            let t = d[i] / m;
+            let phi = FRAC_4_PI * t.atan();
+            u[i] = h * phi + half;
+            let s = h * FRAC_4_PI / (1.0 + t * t) / m;
+            for j in 0..3 {
+                let own = if i == j { 1.0 } else { 0.0 } - if j == k { t * sk } else { 0.0 };
+                jac[i][j] = phi * d[j] / (r * self.cell) + s * own;
+            }
+        }
+        (u, jac)
+    }
+
+    /// A bound on `|∇(F∘u)|` per mm beyond half the bore, from bounds `l` on `|∂F/∂u_a|`:
+    /// `‖J‖ ≤ √3·(1/a + (4/π)·|h|/r)` (the radial part moves `u` by at most `√3/a`, the
+    /// tangential part's two rows by `(4/π)·|h|/m·…`, at most `√3·(4/π)·|h|/r`).
+    pub fn lipschitz(&self, l: Vec3) -> f64 {
+        let a = self.cell;
+        let n = self.cells[0] as f64;
+        let h_over_r = (1.0 / a).max((n / self.bore - 1.0 / a).abs());
+        let norm = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+        norm * 3f64.sqrt() * (1.0 / a + FRAC_4_PI * h_over_r)
+    }
+
+    /// The shortest cell edge at a face's middle (through the wall, or around at the bore or
+    /// the outer wall). Towards the cube's corners cells are sheared (a step through the wall
+    /// crosses them on a slant) and up to a third narrower across; the resolution counts voxels
+    /// on the cells at the faces' middles.
+    pub fn shortest_edge(&self) -> f64 {
+        let around = |r: f64| std::f64::consts::FRAC_PI_4 * r / self.half_side(r);
+        self.cell.min(around(self.bore)).min(around(self.outer()))
+    }
+
+    /// A cell's size in the middle of the wall at a face's middle, mm (two sizes around, one
+    /// through).
+    pub fn mid_cell(&self) -> Vec3 {
+        let r = self.bore + 0.5 * self.cells[1] as f64 * self.cell;
+        let around = std::f64::consts::FRAC_PI_4 * r / self.half_side(r);
+        [around, around, self.cell]
+    }
+
+    /// The box around the shell.
+    pub fn bounds(&self) -> Aabb {
+        let r = self.outer();
+        Aabb {
+            min: self.centre.map(|c| c - r),
+            max: self.centre.map(|c| c + r),
+        }
+    }
+}
+
+impl CellMap for Spherical {
+    fn coords(&self, p: Vec3) -> (Vec3, [Vec3; 3]) {
+        Spherical::coords(self, p)
+    }
+    fn lipschitz(&self, l: Vec3) -> f64 {
+        Spherical::lipschitz(self, l)
+    }
+    /// The bound holds beyond half the bore.
+    fn room(&self, p: Vec3) -> f64 {
+        self.radius(p) - 0.5 * self.bore
+    }
+    fn cut(&self, p: Vec3) -> Option<(f64, Vec3)> {
+        Some(self.implicit_with_gradient(p))
+    }
+    fn bounds(&self) -> Aabb {
+        Spherical::bounds(self)
+    }
+    fn volume(&self) -> f64 {
+        Spherical::volume(self)
+    }
+    fn shortest_edge(&self) -> f64 {
+        Spherical::shortest_edge(self)
+    }
+    fn mid_cell(&self) -> Vec3 {
+        Spherical::mid_cell(self)
+    }
+    fn counts(&self) -> [f64; 3] {
+        let [n, k] = self.cells.map(f64::from);
+        [n, n, k]
+    }
+}
+
+/// The spherical shell as an exact signed distance field.
+impl Field for Spherical {
+    fn value(&self, p: Vec3) -> f64 {
+        let r = self.radius(p);
+        (self.bore - r).max(r - self.outer())
+    }
+
+    fn clearance(&self, p: Vec3) -> f64 {
+        self.value(p).abs()
+    }
+
+    fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
+        let d = [0, 1, 2].map(|i| p[i] - self.centre[i]);
+        let r = self.radius(p).max(1e-300);
+        let out = d.map(|x| x / r);
+        let (inner, outer) = (self.bore - r, r - self.outer());
+        if inner > outer {
+            (inner, out.map(|x| -x))
+        } else {
+            (outer, out)
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The largest singular value of `j`: the square root of `jᵀj`'s largest eigenvalue, by power
+    /// iteration.
+    pub(super) fn largest_singular_value(j: [Vec3; 3]) -> f64 {
+        let mut g = [[0.0; 3]; 3];
+        for (a, row) in g.iter_mut().enumerate() {
+            for (b, x) in row.iter_mut().enumerate() {
+                *x = (0..3).map(|i| j[i][a] * j[i][b]).sum();
+            }
+        }
+        let mut v = [1.0, 0.7, 0.3];
+        let mut lambda = 0.0;
+        for _ in 0..64 {
+            let w = [0, 1, 2].map(|a| (0..3).map(|b| g[a][b] * v[b]).sum::<f64>());
+            let n = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+            if n == 0.0 {
+                return 0.0;
+            }
+            lambda = n;
+            v = w.map(|x| x / n);
+        }
+        lambda.sqrt()
+    }
 
     fn tube() -> Cylindrical {
         Cylindrical::new([1.0, -2.0, 3.0], 6.0, [12, 2, 3], [2.0, 4.0]).unwrap()
@@ -538,5 +839,72 @@ mod tests {
         let v = t0.volume_within(tris, 2.0);
         let exact = std::f64::consts::PI * 4.0 * 2.0;
         assert!((v - exact).abs() < 1e-3 * exact, "{v} vs {exact}");
+    }
+
+    #[test]
+    fn the_cubed_sphere_is_whole_cells_continuous_and_its_jacobian_matches_differences() {
+        let s = Spherical::new([1.0, -2.0, 0.5], 8.0, [4, 2], Some(3.0)).unwrap();
+        let mut rng = 12345u64;
+        let mut next = || {
+            rng = rng
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (rng >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..200 {
+            let d = [next(), next(), next()];
+            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            // On the bore the coordinates are on the cube [0, 4]³'s surface; on the outer wall
+            // on [−2, 6]³'s.
+            for (r, lo, hi) in [(8.0, 0.0, 4.0), (14.0, -2.0, 6.0)] {
+                let p = [0, 1, 2].map(|i| s.centre[i] + r * d[i] / n);
+                let u = s.coords(p).0;
+                assert!(
+                    u.iter().all(|x| *x >= lo - 1e-9 && *x <= hi + 1e-9),
+                    "{u:?}"
+                );
+                assert!(u
+                    .iter()
+                    .any(|x| (x - lo).abs() < 1e-9 || (x - hi).abs() < 1e-9));
+            }
+            let p = [0, 1, 2].map(|i| s.centre[i] + 10.0 * d[i] / n);
+            let (_, j) = s.coords(p);
+            for (a, row) in j.iter().enumerate() {
+                let g = crate::field::numeric_gradient(|q| s.coords(q).0[a], p);
+                for (gi, ji) in g.iter().zip(row) {
+                    assert!((gi - ji).abs() < 1e-5, "{a}: {g:?} {row:?}");
+                }
+            }
+            let norm = largest_singular_value(j);
+            assert!(s.lipschitz([1.0, 0.0, 0.0]) >= norm, "{norm}");
+        }
+        // Across a cube edge (|x| = |y|) the coordinates do not jump.
+        let e = [1.0 + 7.0, -2.0 + 7.0, 0.5 + 2.0];
+        let a = s.coords([e[0] + 1e-9, e[1], e[2]]).0;
+        let b = s.coords([e[0], e[1] + 1e-9, e[2]]).0;
+        assert!((0..3).all(|i| (a[i] - b[i]).abs() < 1e-6), "{a:?} {b:?}");
+        assert_eq!(s.total(), 8 * 8 * 8 - 4 * 4 * 4);
+    }
+
+    #[test]
+    fn the_volume_within_a_sphere_is_exact() {
+        // A cube of half side 5 about the centre holds the whole ball of radius 4 and a part of
+        // the ball of radius 6 (the ball less six caps of height 1).
+        let s = Spherical::new([0.0; 3], 1.0, [2, 1], None).unwrap();
+        let mesh = crate::mesh::Mesh::cuboid([-5.0; 3], [5.0; 3]);
+        let within = |r: f64| {
+            let mut tris = (0..mesh.triangle_count()).map(|i| mesh.triangle(i));
+            Layered::volume_within(&s, &mut tris, r)
+        };
+        let pi = std::f64::consts::PI;
+        let ball = 4.0 / 3.0 * pi * 64.0;
+        assert!((within(4.0) - ball).abs() < 1e-3 * ball, "{}", within(4.0));
+        let cap = pi * 1.0 * (3.0 * 6.0 - 1.0) / 3.0;
+        let exact = 4.0 / 3.0 * pi * 216.0 - 6.0 * cap;
+        assert!(
+            (within(6.0) - exact).abs() < 2e-3 * exact,
+            "{} vs {exact}",
+            within(6.0)
+        );
     }
 }

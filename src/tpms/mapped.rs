@@ -1,5 +1,6 @@
 //! TPMS lattices on a cell map ([`crate::field::cellmap`]): cells wrapped around an axis (the
-//! lattice `F(u(p))` cut by the tube) or growing along one axis of a box. The part goes through the
+//! lattice `F(u(p))` cut by the tube) or a centre (cut by the spherical shell), or growing along
+//! one axis of a box. The part goes through the
 //! one pipeline ([`crate::mesh::pipeline`]): meshed whole (or in tiles), its level found on the
 //! part itself against the tube's volume.
 //!
@@ -14,7 +15,7 @@ use super::calibrate::{self, Connectivity};
 use super::job::TpmsJob;
 use super::{Structure, Surface, TpmsField, TpmsReport};
 use crate::error::{Error, Result};
-use crate::field::cellmap::{CellMap, Cylindrical, GradedCells, Mapping};
+use crate::field::cellmap::{CellMap, Cylindrical, GradedCells, Layered, Mapping, Spherical};
 use crate::field::{intersection_clearance, Aabb, Field, Vec3};
 use crate::grid::GridSpec;
 use crate::io::sink::{MeshSink, Triangle};
@@ -185,6 +186,21 @@ pub enum CellMapReport {
         /// written mesh.
         layer_densities: Vec<f64>,
     },
+    /// Cells wrapped around a centre (a cubed sphere).
+    Spherical {
+        /// The map: centre, bore, cells, size through the wall.
+        #[serde(flatten)]
+        map: Spherical,
+        /// Outer radius, mm.
+        outer_radius: f64,
+        /// The shell's volume, mm³ (the density's base).
+        shell_volume: f64,
+        /// Every cell of the shell.
+        total_cells: u64,
+        /// The density of each layer of cells through the wall, bore outwards, measured on the
+        /// written mesh.
+        layer_densities: Vec<f64>,
+    },
     /// Cells growing along an axis.
     Graded {
         /// The map: box, axis, end sizes, count.
@@ -205,25 +221,25 @@ impl TpmsJob {
     ) -> Result<TpmsReport> {
         match mapping {
             Mapping::Cylindrical(map) => {
-                // The layers are measured on the written triangles on their way to the sink.
-                let mut layers = Layers::new(map, sink);
-                let mut report = self.run_on(map, "tube", progress, &mut layers)?;
-                let layer_densities = layers.densities();
-                for (k, d) in layer_densities.iter().enumerate() {
-                    if (d - self.density).abs() > 0.005 {
-                        report.part.warnings.push(format!(
-                            "layer {} of {} through the wall holds {d:.4}, the tube {:.4}: the map's Jacobian weighs the layers differently",
-                            k + 1,
-                            layer_densities.len(),
-                            report.part.achieved_density
-                        ));
-                    }
-                }
+                let (mut report, layer_densities) =
+                    self.run_layered(map, "tube", progress, sink)?;
                 report.cell_map = Some(CellMapReport::Cylindrical {
                     map,
                     outer_radius: map.outer(),
                     length: map.length(),
                     tube_volume: map.volume(),
+                    layer_densities,
+                });
+                Ok(report)
+            }
+            Mapping::Spherical(map) => {
+                let (mut report, layer_densities) =
+                    self.run_layered(map, "spherical shell", progress, sink)?;
+                report.cell_map = Some(CellMapReport::Spherical {
+                    map,
+                    outer_radius: map.outer(),
+                    shell_volume: map.volume(),
+                    total_cells: map.total(),
                     layer_densities,
                 });
                 Ok(report)
@@ -237,6 +253,32 @@ impl TpmsJob {
                 Ok(report)
             }
         }
+    }
+
+    /// Runs a job on a map whose cells lie in layers through a wall; each layer's density is
+    /// measured on the triangles on their way to the sink (a layer off by more than 0.005 is a
+    /// warning).
+    fn run_layered<M: Layered>(
+        &self,
+        map: M,
+        what: &str,
+        progress: &Progress,
+        sink: &mut dyn MeshSink,
+    ) -> Result<(TpmsReport, Vec<f64>)> {
+        let mut layers = Layers::new(map, sink);
+        let mut report = self.run_on(map, what, progress, &mut layers)?;
+        let layer_densities = layers.densities();
+        for (k, d) in layer_densities.iter().enumerate() {
+            if (d - self.density).abs() > 0.005 {
+                report.part.warnings.push(format!(
+                    "layer {} of {} through the wall holds {d:.4}, the {what} {:.4}: the map's Jacobian weighs the layers differently",
+                    k + 1,
+                    layer_densities.len(),
+                    report.part.achieved_density
+                ));
+            }
+        }
+        Ok((report, layer_densities))
     }
 
     /// Runs a job on the cell map `map` (`what` the part is, for messages).
@@ -344,38 +386,37 @@ impl TpmsJob {
 
 /// A sink that passes the triangles on and measures, as they pass, the solid within each
 /// radius between two layers of cells (bore to outer wall).
-struct Layers<'a> {
+struct Layers<'a, M> {
     sink: &'a mut dyn MeshSink,
-    map: Cylindrical,
+    map: M,
+    radii: Vec<f64>,
     within: Vec<f64>,
 }
 
-impl<'a> Layers<'a> {
-    fn new(map: Cylindrical, sink: &'a mut dyn MeshSink) -> Self {
+impl<'a, M: Layered> Layers<'a, M> {
+    fn new(map: M, sink: &'a mut dyn MeshSink) -> Self {
+        let radii = map.layer_radii();
         Layers {
             sink,
             map,
-            within: vec![0.0; map.cells[1] as usize + 1],
+            within: vec![0.0; radii.len()],
+            radii,
         }
     }
 
-    fn radius(&self, k: usize) -> f64 {
-        self.map.bore + k as f64 * self.map.cell[0]
-    }
-
-    /// The density of each layer: the solid between its two radii over the ring's volume.
+    /// The density of each layer: the solid between its two radii over the region's volume
+    /// there.
     fn densities(&self) -> Vec<f64> {
         (0..self.within.len() - 1)
             .map(|k| {
-                let (r0, r1) = (self.radius(k), self.radius(k + 1));
-                let ring = std::f64::consts::PI * (r1 * r1 - r0 * r0) * self.map.length();
+                let ring = self.map.region_between(self.radii[k], self.radii[k + 1]);
                 (self.within[k + 1] - self.within[k]) / ring
             })
             .collect()
     }
 }
 
-impl MeshSink for Layers<'_> {
+impl<M: Layered> MeshSink for Layers<'_, M> {
     fn begin(&mut self, triangles: Option<u64>) -> Result<()> {
         self.sink.begin(triangles)
     }
@@ -383,12 +424,11 @@ impl MeshSink for Layers<'_> {
     fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
         use rayon::prelude::*;
         let tri = |t: &Triangle| t.map(|p| p.map(f64::from));
-        for k in 0..self.within.len() {
-            let r = self.radius(k);
+        for (k, &r) in self.radii.iter().enumerate() {
             // Fixed chunks added in order: the same sum whatever the scheduling.
             let parts: Vec<f64> = batch
                 .par_chunks(4096)
-                .map(|c| self.map.volume_within(c.iter().map(tri), r))
+                .map(|c| self.map.volume_within(&mut c.iter().map(tri), r))
                 .collect();
             self.within[k] += parts.iter().sum::<f64>();
         }
