@@ -109,7 +109,8 @@ pub struct TpmsArgs {
     /// the seam. spherical: a shell about --origin made of a cube's six faces (a cubed sphere,
     /// no poles); --cells N gives the cells along each face's edge at the bore (4 by default),
     /// --layers the cells through the wall (1), --cell-size the cell's size through the wall
-    /// (by default πR/2N, cubes at the faces' middles); every cell whole.
+    /// (by default πR/2N, cubes at the faces' middles); every cell whole. Towards the cube's
+    /// corners the cells are about half as wide: --resolution counts voxels across those.
     #[arg(long, value_name = "cylindrical|spherical", value_parser = ["cylindrical", "spherical"], requires = "bore")]
     pub cell_map: Option<String>,
     /// Cells through the wall of a --cell-map spherical shell (1 by default).

@@ -583,7 +583,7 @@ impl Spherical {
             )));
         }
         let cell = cell.unwrap_or(std::f64::consts::FRAC_PI_2 * bore / cells[0] as f64);
-        if !(cell > 0.0 && cell.is_finite()) || !centre.iter().all(|c| c.is_finite()) {
+        if !(cell > 0.0 && cell.is_finite() && centre.iter().all(|c| c.is_finite())) {
             return Err(Error::invalid(
                 "the cell size must be positive and the origin finite",
             ));
@@ -665,13 +665,27 @@ impl Spherical {
         norm * 3f64.sqrt() * (1.0 / a + FRAC_4_PI * h_over_r)
     }
 
-    /// The shortest cell edge at a face's middle (through the wall, or around at the bore or
-    /// the outer wall). Towards the cube's corners cells are sheared (a step through the wall
-    /// crosses them on a slant) and up to a third narrower across; the resolution counts voxels
-    /// on the cells at the faces' middles.
+    /// The narrowest a cell gets anywhere: one over the Jacobian's largest singular value, the
+    /// largest over one face's directions (every face is the same) at the bore and the outer
+    /// wall. Towards the cube's corners cells are sheared (a step through the wall crosses
+    /// them on a slant) and narrower across: about half the width at the faces' middles.
     pub fn shortest_edge(&self) -> f64 {
-        let around = |r: f64| std::f64::consts::FRAC_PI_4 * r / self.half_side(r);
-        self.cell.min(around(self.bore)).min(around(self.outer()))
+        let mut most: f64 = 0.0;
+        for r in [self.bore, self.outer()] {
+            for i in 0..=16 {
+                for j in 0..=16 {
+                    let (s, t) = (i as f64 / 16.0, j as f64 / 16.0);
+                    let n = (1.0 + s * s + t * t).sqrt();
+                    let p = [
+                        self.centre[0] + r / n,
+                        self.centre[1] + r * s / n,
+                        self.centre[2] + r * t / n,
+                    ];
+                    most = most.max(largest_singular_value(self.coords(p).1));
+                }
+            }
+        }
+        1.0 / most
     }
 
     /// A cell's size in the middle of the wall at a face's middle, mm (two sizes around, one
@@ -690,6 +704,29 @@ impl Spherical {
             max: self.centre.map(|c| c + r),
         }
     }
+}
+
+/// The largest singular value of `j`: the square root of `jᵀj`'s largest eigenvalue, by power
+/// iteration.
+fn largest_singular_value(j: [Vec3; 3]) -> f64 {
+    let mut g = [[0.0; 3]; 3];
+    for (a, row) in g.iter_mut().enumerate() {
+        for (b, x) in row.iter_mut().enumerate() {
+            *x = (0..3).map(|i| j[i][a] * j[i][b]).sum();
+        }
+    }
+    let mut v = [1.0, 0.7, 0.3];
+    let mut lambda = 0.0;
+    for _ in 0..64 {
+        let w = [0, 1, 2].map(|a| (0..3).map(|b| g[a][b] * v[b]).sum::<f64>());
+        let n = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+        if n == 0.0 {
+            return 0.0;
+        }
+        lambda = n;
+        v = w.map(|x| x / n);
+    }
+    lambda.sqrt()
 }
 
 impl CellMap for Spherical {
@@ -751,29 +788,6 @@ impl Field for Spherical {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The largest singular value of `j`: the square root of `jᵀj`'s largest eigenvalue, by power
-    /// iteration.
-    pub(super) fn largest_singular_value(j: [Vec3; 3]) -> f64 {
-        let mut g = [[0.0; 3]; 3];
-        for (a, row) in g.iter_mut().enumerate() {
-            for (b, x) in row.iter_mut().enumerate() {
-                *x = (0..3).map(|i| j[i][a] * j[i][b]).sum();
-            }
-        }
-        let mut v = [1.0, 0.7, 0.3];
-        let mut lambda = 0.0;
-        for _ in 0..64 {
-            let w = [0, 1, 2].map(|a| (0..3).map(|b| g[a][b] * v[b]).sum::<f64>());
-            let n = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
-            if n == 0.0 {
-                return 0.0;
-            }
-            lambda = n;
-            v = w.map(|x| x / n);
-        }
-        lambda.sqrt()
-    }
 
     fn tube() -> Cylindrical {
         Cylindrical::new([1.0, -2.0, 3.0], 6.0, [12, 2, 3], [2.0, 4.0]).unwrap()

@@ -38,6 +38,13 @@ pub trait Field: Sync {
         (self.value(p), numeric_gradient(|q| self.value(q), p))
     }
 
+    /// Whether the surface is smooth within `reach` of `p`, so that a vertex there may be
+    /// snapped onto it: not where two surfaces meet at an edge that Newton steps do not follow
+    /// (a lattice cut by a curved wall). True by default.
+    fn smooth_near(&self, _p: Vec3, _reach: f64) -> bool {
+        true
+    }
+
     /// Values at `points` (a small, compact set: a block of samples), into `out`. Fields whose
     /// work can be shared across nearby points (a test done once for the whole block) override
     /// it.

@@ -10,6 +10,9 @@
 //!   onto the curve or point where the surface meets them;
 //! * a box corner: onto the corner.
 //!
+//! Where the field says its surface is not smooth within a voxel ([`Field::smooth_near`]: two
+//! curved surfaces meeting at an edge), vertices keep OpenVDB's positions.
+//!
 //! A step that would leave the cell or the clip box is not taken (the vertex keeps the position
 //! OpenVDB gave it). Where the surface meets a clip plane at a grazing angle, snapping can still
 //! tip a sliver triangle through its neighbour: every triangle whose normal turned by more than
@@ -251,6 +254,12 @@ fn snap_vertex(
         }
     }
 
+    // Where the surface is not smooth (a lattice meeting a curved wall), OpenVDB's vertex stays:
+    // one Newton step would land on either side of the edge, and neighbours on different
+    // sides can cross.
+    if !surface.smooth_near(v, h) {
+        return (Outcome::Kept, None);
+    }
     if plane.iter().all(Option::is_none) {
         return match newton(v, surface, [false; 3]) {
             Some(w) if inside(w) => (Outcome::Surface, Some(w)),

@@ -92,6 +92,19 @@ impl<M: CellMap> Field for MappedField<M> {
         }
     }
 
+    /// Not smooth where the lattice meets the region's curved wall (a tube's or a shell's):
+    /// Newton steps on the larger of the two land on either side of the edge, and neighbouring
+    /// vertices on different sides can cross (a self-intersection CGAL finds).
+    fn smooth_near(&self, p: Vec3, reach: f64) -> bool {
+        match self.map.cut(p) {
+            Some((b, _)) if b.abs() < reach => {
+                let (f, _, g) = self.eval(p);
+                self.tpms.distance_at(f, g, self.tpms.level).abs() >= reach
+            }
+            _ => true,
+        }
+    }
+
     fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
         let (f, v, g) = self.eval(p);
         let sign = match self.tpms.structure {
