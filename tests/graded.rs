@@ -813,6 +813,47 @@ fn graded_parts_are_saved_as_part_files() {
     }
 }
 
+/// A part made with `--cell-map KIND --bore R …` (`map`: the kind, the bore and the map's own
+/// options), `args`, about `centre`, written as `NAME.stl` with its report, checked clean by
+/// CGAL: the folder, the report and the command line.
+fn make_on_map(
+    map: &[&str],
+    args: &[&str],
+    surface: &str,
+    density: f64,
+    centre: &str,
+    name: &str,
+) -> (tempfile::TempDir, serde_json::Value, Vec<String>) {
+    let dir = tempdir();
+    let (stl, report) = (format!("{name}.stl"), format!("{name}.json"));
+    let density = density.to_string();
+    let mut all = vec![
+        "tpms",
+        "--type",
+        surface,
+        "--cell-map",
+        map[0],
+        "--bore",
+        map[1],
+    ];
+    all.extend_from_slice(&map[2..]);
+    all.extend_from_slice(&[
+        "--origin",
+        centre,
+        "--density",
+        &density,
+        "--verify",
+        "cgal",
+    ]);
+    all.extend_from_slice(&["-q", "-o", &stl, "--report", &report]);
+    all.extend_from_slice(args);
+    ok(&all, dir.path());
+    let r = json(&dir.path().join(&report));
+    assert_clean_by_cgal(&r, &format!("{all:?}"));
+    let all = all.iter().map(|a| a.to_string()).collect();
+    (dir, r, all)
+}
+
 /// The tube's cells as manifold3d measured them (`checkers/tube_cells.py`).
 fn measure_tube(
     stl: &Path,
@@ -846,39 +887,18 @@ fn check_tube(
     cells: [u32; 3],
     cell: f64,
 ) -> f64 {
-    let dir = tempdir();
     let s = |v: &[String]| v.join(",");
     let (centre_s, bore_s) = (s(&centre.map(|x| x.to_string())), bore.to_string());
     let (cells_s, cell_s) = (s(&cells.map(|x| x.to_string())), cell.to_string());
-    let density_s = density.to_string();
-    let mut all = vec![
-        "tpms",
-        "--type",
-        surface,
-        "--cell-map",
+    let map = [
         "cylindrical",
-        "--bore",
         &bore_s,
         "--cells",
         &cells_s,
         "--cell-size",
         &cell_s,
-        "--origin",
-        &centre_s,
-        "--density",
-        &density_s,
-        "--verify",
-        "cgal",
-        "-q",
-        "-o",
-        "tube.stl",
-        "--report",
-        "tube.json",
     ];
-    all.extend_from_slice(args);
-    ok(&all, dir.path());
-    let r = json(&dir.path().join("tube.json"));
-    assert_clean_by_cgal(&r, &format!("{all:?}"));
+    let (dir, r, all) = make_on_map(&map, args, surface, density, &centre_s, "tube");
     let m = measure_tube(
         &dir.path().join("tube.stl"),
         &centre_s,
@@ -995,17 +1015,11 @@ fn check_shell(
     cells: [u32; 2],
     cell: f64,
 ) -> f64 {
-    let dir = tempdir();
     let centre_s = centre.map(|x| x.to_string()).join(",");
-    let (bore_s, cell_s, density_s) = (bore.to_string(), cell.to_string(), density.to_string());
+    let (bore_s, cell_s) = (bore.to_string(), cell.to_string());
     let (n_s, k_s) = (cells[0].to_string(), cells[1].to_string());
-    let mut all = vec![
-        "tpms",
-        "--type",
-        surface,
-        "--cell-map",
+    let map = [
         "spherical",
-        "--bore",
         &bore_s,
         "--cells",
         &n_s,
@@ -1013,22 +1027,8 @@ fn check_shell(
         &k_s,
         "--cell-size",
         &cell_s,
-        "--origin",
-        &centre_s,
-        "--density",
-        &density_s,
-        "--verify",
-        "cgal",
-        "-q",
-        "-o",
-        "shell.stl",
-        "--report",
-        "shell.json",
     ];
-    all.extend_from_slice(args);
-    ok(&all, dir.path());
-    let r = json(&dir.path().join("shell.json"));
-    assert_clean_by_cgal(&r, &format!("{all:?}"));
+    let (dir, r, all) = make_on_map(&map, args, surface, density, &centre_s, "shell");
     let [n, k] = cells.map(|c| c as i64);
     assert_eq!(r["cell_map"]["total_cells"], (n + 2 * k).pow(3) - n.pow(3));
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checkers/sphere_cells.py");
