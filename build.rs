@@ -20,6 +20,8 @@ const VDB_UNITS: [&str; 8] = [
 /// The translation units behind `cpp/cgal.h`.
 const CGAL_CHECK_UNIT: &str = "cpp/cgal_check.cc";
 const CGAL_REPAIR_UNIT: &str = "cpp/cgal_repair.cc";
+const CGAL_BOOLEAN_UNIT: &str = "cpp/cgal_boolean.cc";
+const CGAL_DISTANCE_UNIT: &str = "cpp/cgal_distance.cc";
 
 const INSTALL_HINT: &str = "run `bash scripts/install-deps.sh` (Debian bookworm: libopenvdb-dev, libcgal-dev, libtbb-dev, libgmp-dev, libmpfr-dev, libeigen3-dev)";
 
@@ -78,6 +80,21 @@ fn main() {
         .file(CGAL_REPAIR_UNIT)
         .compile("latvox_cgal_repair");
 
+    // Corefinement (booleans), with CGAL's checks on: its inputs are checked here at run time
+    // and a failed check is a reason to fall back, not a crash.
+    let mut cgal_boolean = cxx_build::bridges(std::iter::empty::<&str>());
+    flags(&mut cgal_boolean);
+    cgal_boolean
+        .define("CGAL_LINKED_WITH_TBB", None)
+        .file(CGAL_BOOLEAN_UNIT)
+        .compile("latvox_cgal_boolean");
+    let mut cgal_distance = cxx_build::bridges(std::iter::empty::<&str>());
+    flags(&mut cgal_distance);
+    cgal_distance
+        .define("CGAL_LINKED_WITH_TBB", None)
+        .file(CGAL_DISTANCE_UNIT)
+        .compile("latvox_cgal_distance");
+
     for lib in ["openvdb", "tbb", "Imath-3_1", "gmp", "mpfr"] {
         println!("cargo:rustc-link-lib={lib}");
     }
@@ -85,7 +102,12 @@ fn main() {
         .into_iter()
         .chain(HEADERS)
         .chain(VDB_UNITS)
-        .chain([CGAL_CHECK_UNIT, CGAL_REPAIR_UNIT])
+        .chain([
+            CGAL_CHECK_UNIT,
+            CGAL_REPAIR_UNIT,
+            CGAL_BOOLEAN_UNIT,
+            CGAL_DISTANCE_UNIT,
+        ])
     {
         println!("cargo:rerun-if-changed={f}");
     }

@@ -1,6 +1,7 @@
 // CGAL side of the bridge, on indexed triangle soups: closed-mesh measures and validity checks
 // (cgal_check.cc); self-intersections of any soup and hole filling, the repair steps
-// (cgal_repair.cc, compiled apart with its own CGAL settings). One header for the whole library.
+// (cgal_repair.cc, compiled apart with its own CGAL settings); the union of closed shells by
+// corefinement (cgal_boolean.cc); distances from points to a soup (cgal_distance.cc). One header for the whole library.
 #pragma once
 #include <cstdint>
 #include "rust/cxx.h"
@@ -10,6 +11,8 @@ namespace latvox {
 struct CgalReport;
 struct SoupIntersections;
 struct HoleFill;
+struct ShellUnion;
+struct PointDistances;
 
 // cgal_check.cc
 CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
@@ -24,5 +27,14 @@ SoupIntersections cgal_soup_self_intersections(rust::Slice<const float> position
 
 HoleFill cgal_fill_holes(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
                          rust::Slice<const uint32_t> hole_starts, bool fair);
+
+// cgal_boolean.cc
+ShellUnion cgal_union(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
+                      rust::Slice<const uint32_t> shell_starts);
+
+// cgal_distance.cc
+PointDistances cgal_distances(rust::Slice<const float> positions,
+                              rust::Slice<const uint32_t> indices,
+                              rust::Slice<const double> points, bool classify);
 
 }  // namespace latvox

@@ -10,8 +10,10 @@
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/shape_predicates.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/boost/graph/helpers.h>
+#include <CGAL/exceptions.h>
 
 #include <array>
 #include <cmath>
@@ -29,6 +31,10 @@ using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Mesh = CGAL::Surface_mesh<K::Point_3>;
 
 namespace {
+
+// Bits of CgalReport::unchecked (src/ffi/cgal.rs).
+constexpr uint8_t UNCHECKED_ORIENTATION = 1, UNCHECKED_SELF_INTERSECTION = 2,
+                  UNCHECKED_MEASURES = 4;
 
 // Builds a Surface_mesh from an indexed soup. Returns false (with a repaired mesh) when the soup
 // is not an oriented 2-manifold as given.
@@ -85,22 +91,49 @@ CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint
     if (mesh.is_border(h)) ++border;
   r.border_edges = border;
   r.closed = border == 0;
-  r.area = PMP::area(mesh);
-  auto fcc = mesh.add_property_map<Mesh::Face_index, std::size_t>("f:cc").first;
-  r.components = PMP::connected_components(mesh, fcc);
+  // Each CGAL step states preconditions a hostile mesh can break (a closed shell with no inside,
+  // facets back to back): a step whose precondition fails is reported as not checked, never
+  // passed on as an error.
+  auto guarded = [&r](uint8_t step, auto&& run) {
+    try {
+      run();
+    } catch (const CGAL::Failure_exception&) {
+      r.unchecked |= step;
+    }
+  };
+  guarded(UNCHECKED_MEASURES, [&] {
+    r.area = PMP::area(mesh);
+    auto fcc = mesh.add_property_map<Mesh::Face_index, std::size_t>("f:cc").first;
+    r.components = PMP::connected_components(mesh, fcc);
+  });
+  r.outward = false;
+  r.volume = std::numeric_limits<double>::quiet_NaN();
+  bool degenerate = false;
+  for (auto f : mesh.faces()) degenerate = degenerate || PMP::is_degenerate_triangle_face(f, mesh);
   if (r.closed && mesh.number_of_faces() > 0) {
-    r.outward = PMP::is_outward_oriented(mesh);
-    r.volume = PMP::volume(mesh);
-  } else {
-    r.outward = false;
-    r.volume = std::numeric_limits<double>::quiet_NaN();
+    if (degenerate)
+      r.unchecked |= UNCHECKED_ORIENTATION;
+    else
+      guarded(UNCHECKED_ORIENTATION, [&] {
+        r.outward = PMP::is_outward_oriented(mesh);
+        r.volume = PMP::volume(mesh);
+      });
+    if (r.unchecked & UNCHECKED_ORIENTATION) {
+      r.outward = false;
+      r.volume = std::numeric_limits<double>::quiet_NaN();
+    }
   }
-  r.self_intersection_checked = self_intersection;
-  // TBB's parallel search costs about twice the CPU of the sequential one: worth it only when
-  // nothing else needs the other cores.
-  r.self_intersecting =
-      self_intersection && (parallel ? PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh)
-                                     : PMP::does_self_intersect<CGAL::Sequential_tag>(mesh));
+  r.self_intersection_checked = false;
+  if (self_intersection) {
+    // TBB's parallel search costs about twice the CPU of the sequential one: worth it only when
+    // nothing else needs the other cores.
+    guarded(UNCHECKED_SELF_INTERSECTION, [&] {
+      r.self_intersecting =
+          parallel ? PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh)
+                   : PMP::does_self_intersect<CGAL::Sequential_tag>(mesh);
+      r.self_intersection_checked = true;
+    });
+  }
   return r;
 }
 

@@ -17,6 +17,7 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/Surface_mesh.h>
+#include <CGAL/exceptions.h>
 
 #include <tbb/parallel_for.h>
 
@@ -168,12 +169,18 @@ HoleFill cgal_fill_holes(rust::Slice<const float> positions, rust::Slice<const u
     std::vector<SMesh::Face_index> new_faces;
     std::vector<SMesh::Vertex_index> new_vertices;
     bool faired = false;
-    if (fair) {
-      faired = std::get<0>(PMP::triangulate_refine_and_fair_hole(
-          mesh, h, std::back_inserter(new_faces), std::back_inserter(new_vertices)));
-    } else {
-      PMP::triangulate_and_refine_hole(mesh, h, std::back_inserter(new_faces),
-                                       std::back_inserter(new_vertices));
+    // A hole whose border breaks a precondition of CGAL's (a pinched or self-crossing loop)
+    // stays open and is reported, like one the triangulation could not close.
+    try {
+      if (fair) {
+        faired = std::get<0>(PMP::triangulate_refine_and_fair_hole(
+            mesh, h, std::back_inserter(new_faces), std::back_inserter(new_vertices)));
+      } else {
+        PMP::triangulate_and_refine_hole(mesh, h, std::back_inserter(new_faces),
+                                         std::back_inserter(new_vertices));
+      }
+    } catch (const CGAL::Failure_exception&) {
+      faired = false;
     }
     out.filled.push_back(!new_faces.empty() && !mesh.is_border(h));
     out.faired.push_back(faired);

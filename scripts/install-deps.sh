@@ -70,3 +70,22 @@ if ! command -v cargo-fuzz >/dev/null 2>&1 && [ ! -x "${CARGO_HOME:-$HOME/.cargo
   echo "install-deps: installing cargo-fuzz" >&2
   cargo install --locked cargo-fuzz
 fi
+
+# check/repair tests: real meshes shipped with Debian's slicers (printer beds, platforms, test
+# shapes from Cura and PrusaSlicer), taken out of the packages without installing them (nor
+# their GUI dependencies).
+CORPUS=/usr/local/share/latvox/slicer-meshes
+if [ ! -f "$CORPUS/.complete" ]; then
+  echo "install-deps: unpacking the meshes of Debian's cura and prusa-slicer packages" >&2
+  tmp=$(mktemp -d)
+  (cd "$tmp" && { apt-get download cura prusa-slicer >/dev/null 2>&1 ||
+    { "${SUDO[@]}" apt-get update -qq && apt-get download cura prusa-slicer >/dev/null; }; })
+  for pkg in cura prusa-slicer; do
+    dpkg-deb -x "$tmp"/"${pkg}"_*.deb "$tmp/$pkg"
+    "${SUDO[@]}" mkdir -p "$CORPUS/$pkg"
+    find "$tmp/$pkg" -type f \( -iname '*.stl' -o -iname '*.3mf' -o -iname '*.obj' \) \
+      -size -3M -exec "${SUDO[@]}" cp -t "$CORPUS/$pkg" {} +
+  done
+  "${SUDO[@]}" touch "$CORPUS/.complete"
+  rm -rf "$tmp"
+fi

@@ -35,6 +35,10 @@ pub struct Verification {
     pub border_edges: u64,
     /// Connected components.
     pub components: u64,
+    /// What CGAL could not check on this mesh, and why (its preconditions did not hold); those
+    /// properties count as not holding.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub not_checked: Option<&'static str>,
 }
 
 impl Verification {
@@ -67,5 +71,17 @@ pub fn verify_on(mesh: &Mesh, self_intersection: bool, parallel: bool) -> Result
         vertices: r.vertices,
         border_edges: r.border_edges,
         components: r.components,
+        not_checked: not_checked(r.unchecked),
     })
+}
+
+/// The steps CGAL refused (bits of the bridge's `unchecked`), in words.
+fn not_checked(bits: u8) -> Option<&'static str> {
+    match bits & 7 {
+        0 => None,
+        1 => Some("orientation and volume: a closed shell without an inside (degenerate or flat facets, facets back to back)"),
+        2 => Some("self-intersection: the mesh breaks CGAL's preconditions for the search"),
+        3 => Some("orientation, volume and self-intersection: the mesh breaks CGAL's preconditions"),
+        _ => Some("area, components and more: the mesh breaks CGAL's preconditions"),
+    }
 }

@@ -12,6 +12,7 @@
 //! neither degenerate nor duplicates (those are counted on their own).
 
 pub mod cgal;
+pub mod deviation;
 mod file;
 pub mod self_intersect;
 pub(crate) mod verdict;

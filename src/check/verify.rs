@@ -109,6 +109,7 @@ fn verification(mesh: &Mesh, how: Verify, topo: Fans, pairs: Option<u64>) -> Ver
         vertices: topo.vertices,
         border_edges: topo.border_edges,
         components: topo.components,
+        not_checked: None,
     }
 }
 
@@ -128,6 +129,7 @@ fn unchecked(mesh: &Mesh) -> Verification {
         vertices: mesh.vertex_count() as u64,
         border_edges: 0,
         components: 0,
+        not_checked: None,
     }
 }
 

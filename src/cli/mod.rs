@@ -169,8 +169,12 @@ pub(crate) fn cgal_findings(c: &latvox::check::cgal::Verification) -> String {
     if c.checked_by == latvox::check::verify::Verify::None.by() {
         return "not checked (--verify none)".into();
     }
+    let refused = c
+        .not_checked
+        .map(|r| format!("  (not checked: {r})"))
+        .unwrap_or_default();
     format!(
-        "closed {}  outward {}  manifold {}  self-intersections {}",
+        "closed {}  outward {}  manifold {}  self-intersections {}{refused}",
         yes(c.closed),
         yes(c.outward),
         yes(c.manifold),

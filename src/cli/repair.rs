@@ -6,7 +6,7 @@ use super::out::outln;
 use clap::Args;
 use latvox::mesh::output::MeshFile;
 use latvox::progress::Progress;
-use latvox::repair::{repair_file, FileRepairReport, RepairOptions};
+use latvox::repair::{repair_file, FileRepairReport, Remesh, RepairOptions};
 use latvox::Result;
 use std::path::PathBuf;
 
@@ -14,6 +14,8 @@ pub(crate) const EXAMPLES: &str = "\
 Examples:
   latvox repair scan.stl -o fixed.stl
   latvox repair export.obj -o fixed.3mf --report repair.json
+  latvox repair assembly.3mf -o print.stl --solid
+  latvox repair broken.ply -o solid.stl --remesh auto
   latvox repair broken.ply -o solid.stl --remesh 0.2
   latvox repair assembly.stl -o part.stl --drop-open-shells
 
@@ -22,13 +24,26 @@ T-junctions; separates shells that touch at a vertex or along an edge; makes win
 consistent and every closed shell outward (cavities inward); fills holes (planar ones by
 triangulating the loop, curved ones with CGAL's triangulate-refine-fair); recomputes normals.
 A valid mesh comes back unchanged. Shells that stay open are reported, and only dropped with
---drop-open-shells. --remesh VOXEL rebuilds the part through an OpenVDB level set: closed,
-manifold and free of self-intersections at that resolution (details below a voxel are lost).
+--drop-open-shells.
+
+--solid: when the file must print as one solid (assemblies of overlapping parts, exports with
+stray facets, shells crossing each other or themselves). After the repair above, shells that
+are still open have no inside and are dropped (counted); shells that overlap or cross are
+joined: by CGAL's corefinement (an exact union) when each is a clean closed shell, otherwise
+their group alone is remeshed through OpenVDB; if anything is still wrong, the whole part is
+remeshed. The result is one valid closed solid, or the reason none exists.
+
+--remesh VOXEL|auto rebuilds the part through an OpenVDB level set: closed, manifold and free
+of self-intersections at that resolution (details below a voxel are lost). auto: a quarter of
+the thinnest shell's mean thickness (2·volume/area), at most 1/64 of the part, within a memory
+bound. With --solid, it sets the voxel of the remeshes the solid needs. When geometry moved,
+the deviation from the input is measured both ways (every vertex to the other mesh, CGAL).
 
 The output format follows the extension of -o (.stl .obj .off .ply .3mf).
-Self-intersections are counted on the result only (repair does not mend them; --remesh does).
-Exit code 0 when the result is a valid closed solid, 1 when defects remain (the repaired file is
-still written), 2 on bad input or arguments (nothing written).";
+Self-intersections are counted on the result only (--solid and --remesh mend them).
+Exit codes: 0 the result written is a valid closed solid; 1 it is written but defects remain
+(listed); 2 bad input or arguments, or no solid exists (nothing written); 3 an internal failure
+(a bug to report).";
 
 #[derive(Args)]
 pub struct RepairArgs {
@@ -54,9 +69,20 @@ pub struct RepairArgs {
     /// Drop shells that are still open after repair (they are reported either way).
     #[arg(long)]
     pub drop_open_shells: bool,
-    /// Rebuild the part through an OpenVDB level set with this voxel size (mm).
-    #[arg(long, value_name = "VOXEL", value_parser = super::parse_positive)]
-    pub remesh: Option<f64>,
+    /// Rebuild the part through an OpenVDB level set with this voxel size (mm), or `auto`.
+    #[arg(long, value_name = "VOXEL|auto", value_parser = parse_remesh)]
+    pub remesh: Option<Remesh>,
+    /// End in one valid closed solid: drop open shells, join overlapping or crossing ones.
+    #[arg(long)]
+    pub solid: bool,
+}
+
+fn parse_remesh(s: &str) -> std::result::Result<Remesh, String> {
+    if s == "auto" {
+        Ok(Remesh::Auto)
+    } else {
+        super::parse_positive(s).map(Remesh::Voxel)
+    }
 }
 
 impl RepairArgs {
@@ -68,6 +94,7 @@ impl RepairArgs {
             stitch_tolerance: self.stitch_tolerance,
             drop_open_shells: self.drop_open_shells,
             remesh: self.remesh,
+            solid: self.solid,
         }
     }
 }
@@ -135,10 +162,35 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
                 changes.non_orientable_shells
             );
         }
+        if let Some(sr) = &changes.solid {
+            for why in &sr.remesh_reasons {
+                outln!("remeshed  a group of crossing shells: {why}");
+            }
+        }
+        if let Some(v) = changes.remesh_voxel {
+            outln!("voxel     {v:.4} mm (remesh)");
+        }
+        if let Some(d) = &r.deviation {
+            outln!(
+                "deviation result→input max {:.4} mm, mean {:.4} mm; input→result max {:.4} mm, mean {:.4} mm (at vertices, CGAL){}",
+                d.output_to_input.max,
+                d.output_to_input.mean,
+                d.input_to_output.max,
+                d.input_to_output.mean,
+                if d.input_vertices_inside > 0 {
+                    format!(
+                        "; {} input vertices on walls now inside the solid",
+                        d.input_vertices_inside
+                    )
+                } else {
+                    String::new()
+                }
+            );
+        }
         outln!("after ({})", r.output);
         print_summary(&r.after);
-        if r.verdict.self_intersecting && a.remesh.is_none() {
-            outln!("hint      self-intersections remain: --remesh VOXEL rebuilds the part without them");
+        if r.verdict.self_intersecting && a.remesh.is_none() && !a.solid {
+            outln!("hint      self-intersections remain: --solid joins the crossing shells");
         }
         outln!(
             "verdict   {}",

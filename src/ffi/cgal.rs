@@ -18,6 +18,9 @@ pub(crate) mod ffi {
         vertices: u64,
         border_edges: u64,
         components: u64,
+        /// Steps whose CGAL preconditions the mesh broke, so they did not run: bit 1
+        /// orientation and volume, bit 2 self-intersection, bit 4 area and components.
+        unchecked: u8,
     }
 
     /// Intersecting facet pairs of a soup.
@@ -34,6 +37,22 @@ pub(crate) mod ffi {
         /// Per requested hole: closed, and (if fairing was asked for) faired.
         filled: Vec<bool>,
         faired: Vec<bool>,
+    }
+
+    /// The union of closed shells, or why there is none.
+    struct ShellUnion {
+        ok: bool,
+        /// Why not (a failed precondition, a non-manifold result), when `ok` is false.
+        reason: String,
+        positions: Vec<f64>,
+        indices: Vec<u32>,
+    }
+
+    /// Distances from points to a soup's facets, and (when asked and the soup is a closed
+    /// 2-manifold) whether each point is inside; `inside` is empty otherwise.
+    struct PointDistances {
+        distances: Vec<f64>,
+        inside: Vec<bool>,
     }
 
     unsafe extern "C++" {
@@ -63,5 +82,21 @@ pub(crate) mod ffi {
             hole_starts: &[u32],
             fair: bool,
         ) -> Result<HoleFill>;
+
+        /// The union of the closed shells `indices[3 * shell_starts[s]..3 * shell_starts[s + 1]]`
+        /// by corefinement.
+        fn cgal_union(
+            positions: &[f32],
+            indices: &[u32],
+            shell_starts: &[u32],
+        ) -> Result<ShellUnion>;
+
+        /// Distances from `points` (xyz triples) to the facets of the soup.
+        fn cgal_distances(
+            positions: &[f32],
+            indices: &[u32],
+            points: &[f64],
+            classify: bool,
+        ) -> Result<PointDistances>;
     }
 }

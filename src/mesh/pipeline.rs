@@ -765,6 +765,7 @@ fn write_tiled<S: Solid>(
             vertices: out.vertices,
             border_edges: out.bad_edges,
             components: 0,
+            not_checked: None,
         },
         meshing: stats.into_inner().expect("no panic while holding the lock"),
         measures: m,

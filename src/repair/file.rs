@@ -2,6 +2,7 @@
 //! and give the verdict on the file as written and read back, as the next program will see it.
 
 use super::{repair, RepairOptions, RepairReport};
+use crate::check::deviation::{deviation, Deviation};
 use crate::check::{check, read_file, CheckOptions, CheckReport, Defects, Verdict};
 use crate::error::{Error, Result};
 use crate::io::{Format, ReadOptions, Reading};
@@ -32,6 +33,9 @@ pub struct FileRepairReport {
     pub after: CheckReport,
     /// The defect classes left in the written file, with their counts.
     pub defects_after: Defects,
+    /// How far the result lies from the input, when repair moved geometry (a remesh, a union).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub deviation: Option<Deviation>,
     /// The verdict on `after` (in JSON, the one flag `valid_solid`).
     #[serde(
         rename = "valid_solid",
@@ -84,6 +88,17 @@ pub fn repair_file(
         let written = crate::io::read(&output.path, &ReadOptions::default())?;
         check(&written.mesh, written.normals.as_deref(), check_opts)?
     };
+    let moved = changes.remesh_voxel.is_some()
+        || changes
+            .solid
+            .as_ref()
+            .is_some_and(|s| s.intersecting_groups > 0);
+    let deviation = if moved {
+        let _s = progress.stage("measuring the deviation from the input");
+        Some(deviation(&loaded.mesh, &mesh)?)
+    } else {
+        None
+    };
     let normals_recomputed = before
         .normals
         .map(|n| n.reversed + n.inaccurate + n.unset)
@@ -98,6 +113,7 @@ pub fn repair_file(
         repair: changes,
         normals_recomputed,
         defects_after: Defects::from(&after),
+        deviation,
         verdict: after.verdict(),
         after,
     })

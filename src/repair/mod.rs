@@ -11,6 +11,8 @@
 //!    fair).
 //! 7. Turn every closed shell outward (a cavity inward), by nesting parity.
 //! 8. Optionally drop the shells that are still open, and optionally remesh through OpenVDB.
+//! 9. For a solid (`--solid`): drop the open shells, join shells that intersect or overlap
+//!    (CGAL's corefinement, or a remesh of their group) — see [`solid`].
 //!
 //! A mesh without defects passes through unchanged (same facets in the same order). A shell that
 //! stays open is reported, never dropped unless asked. Normals are recomputed by the writers.
@@ -19,6 +21,7 @@ pub mod cgal;
 mod file;
 mod holes;
 pub mod remesh;
+pub mod solid;
 mod split;
 
 use crate::check;
@@ -29,6 +32,7 @@ use crate::progress::Progress;
 
 pub use file::{repair_file, FileRepairReport};
 pub use holes::PLANAR_REL;
+pub use solid::SolidReport;
 
 /// How to repair.
 #[derive(Debug, Clone, Copy)]
@@ -41,8 +45,20 @@ pub struct RepairOptions {
     pub stitch_tolerance: Option<f64>,
     /// Drop shells that are still open after repair.
     pub drop_open_shells: bool,
-    /// Rebuild the part through an OpenVDB level set at this voxel size (mm).
-    pub remesh: Option<f64>,
+    /// Rebuild the part through an OpenVDB level set (with `solid`: the voxel size of the
+    /// remeshes the solid needs, if any).
+    pub remesh: Option<Remesh>,
+    /// End in one valid closed solid: drop open shells, join intersecting ones ([`solid`]).
+    pub solid: bool,
+}
+
+/// The voxel size of a remesh.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Remesh {
+    /// Chosen from the part ([`remesh::auto_voxel`]).
+    Auto,
+    /// This size, mm.
+    Voxel(f64),
 }
 
 impl Default for RepairOptions {
@@ -53,6 +69,7 @@ impl Default for RepairOptions {
             stitch_tolerance: None,
             drop_open_shells: false,
             remesh: None,
+            solid: false,
         }
     }
 }
@@ -94,6 +111,9 @@ pub struct RepairReport {
     pub remesh_voxel: Option<f64>,
     /// Active voxels of the remesh's level set, when it ran.
     pub remesh_active_voxels: Option<u64>,
+    /// What making a solid did (`--solid`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub solid: Option<solid::SolidReport>,
 }
 
 /// The mesh being repaired, with its topology cached until the next change.
@@ -334,13 +354,55 @@ pub fn repair(
         let flipped = orient_outward(&mut w);
         w.note("shells turned outward", flipped);
     }
-    let open_shells = w.open_shells(opts.drop_open_shells);
-    let remesh_active = match opts.remesh {
-        Some(voxel) => {
+    let open_shells = w.open_shells(opts.drop_open_shells || opts.solid);
+    let fixed_voxel = match opts.remesh {
+        Some(Remesh::Voxel(v)) => Some(v),
+        _ => None,
+    };
+    let mut remesh_voxel = None;
+    let solid_report = if opts.solid {
+        if w.mesh.triangle_count() == 0 {
+            return Err(crate::error::Error::invalid(
+                "no solid: nothing is closed enough to have an inside (every shell is open or degenerate)",
+            ));
+        }
+        let _s = progress.stage("joining intersecting shells");
+        let (m, rep) = solid::unite(&w.mesh, fixed_voxel)?;
+        if rep.intersecting_groups > 0 {
+            w.mesh = m;
+            w.topo = None;
+        }
+        w.note(
+            "overlapping shells joined by CGAL's corefinement",
+            rep.shells_united,
+        );
+        w.note(
+            "intersecting shells remeshed through OpenVDB",
+            rep.shells_remeshed,
+        );
+        w.note(
+            "whole part remeshed (last resort)",
+            rep.whole_part_remeshed as u64,
+        );
+        remesh_voxel = rep.voxel;
+        if w.mesh.triangle_count() == 0 {
+            return Err(crate::error::Error::invalid(format!(
+                "no solid: the closed shells are thinner than the remesh voxel ({:.4} mm) and vanished",
+                rep.voxel.unwrap_or(0.0)
+            )));
+        }
+        Some(rep)
+    } else {
+        None
+    };
+    let remesh_active = match (opts.remesh, opts.solid) {
+        (Some(_), false) => {
             let _s = progress.stage("remeshing through OpenVDB");
+            let voxel = fixed_voxel.unwrap_or_else(|| remesh::auto_voxel(&w.mesh));
+            remesh_voxel = Some(voxel);
             Some(w.remesh(voxel)?)
         }
-        None => None,
+        _ => None,
     };
     let removed = compact(&mut w.mesh);
     w.note("unreferenced vertices removed", removed);
@@ -352,8 +414,9 @@ pub fn repair(
             open_shells,
             non_orientable_shells: non_orientable,
             holes_left,
-            remesh_voxel: opts.remesh,
+            remesh_voxel,
             remesh_active_voxels: remesh_active,
+            solid: solid_report,
         },
     ))
 }

@@ -2,13 +2,32 @@
 //! level set at the given voxel size and its zero iso-surface becomes the new mesh. Whatever
 //! cannot be mended locally — self-intersections, overlapping shells, slivers — disappears; the
 //! result is closed and manifold at that resolution, and features smaller than a voxel are lost.
+//!
+//! Volume-to-mesh alone is not always a valid mesh as a file holds it: where the input's faces
+//! lie on voxel planes (CAD parts at round voxel sizes) samples read exactly zero, OpenVDB's
+//! points of neighbouring voxels meet on their common face, and once written in single
+//! precision (and welded by position, as STL readers do) they are one vertex, their facets
+//! degenerate. So the part is meshed on a grid shifted by an irrational fraction of a voxel (no
+//! face on a voxel plane), the result is welded exactly as a file will hold it, facets that
+//! collapsed are dropped, and the whole is checked (closed, manifold, no degenerate facet); a
+//! result that fails is meshed again on another shift.
 
+use crate::check::{check, CheckOptions};
 use crate::error::{Error, Result};
 use crate::grid::Grid;
 use crate::mesh::Mesh;
 
+/// Sub-voxel shifts of the grid, tried in turn (fractions of a voxel, far from simple ratios).
+const SHIFTS: [[f64; 3]; 3] = [
+    [0.381_966, 0.236_068, 0.145_898],
+    [0.618_034, 0.472_136, 0.291_796],
+    [0.090_170, 0.708_204, 0.527_864],
+];
+
 /// Rebuilds `mesh` at `voxel` mm (adaptivity 0: uniform triangles). Returns the new mesh and the
-/// number of active voxels used.
+/// number of active voxels used. The mesh is closed, manifold and free of degenerate facets as
+/// written in single precision, or (should no shift give one) the last one tried, its defects
+/// left for the caller's check to report.
 pub fn remesh(mesh: &Mesh, voxel: f64) -> Result<(Mesh, u64)> {
     if !(voxel > 0.0 && voxel.is_finite()) {
         return Err(Error::invalid(
@@ -25,6 +44,94 @@ pub fn remesh(mesh: &Mesh, voxel: f64) -> Result<(Mesh, u64)> {
             )));
         }
     }
-    let grid = Grid::from_mesh(mesh, voxel, 3.0)?;
-    Ok((grid.to_mesh(0.0)?, grid.active_voxels()))
+    let mut last = None;
+    for shift in SHIFTS {
+        let d = shift.map(|s| s * voxel);
+        let grid = Grid::from_mesh(&translated(mesh, d), voxel, 3.0)?;
+        let mut out = grid.to_mesh(0.0)?;
+        out = translated(&out, d.map(|x| -x));
+        let out = crate::io::weld::weld_indexed(&out.positions, &out.indices)?;
+        let out = drop_collapsed(out);
+        let found = check(
+            &out,
+            None,
+            &CheckOptions {
+                self_intersections: false,
+                tolerance: 0.0,
+            },
+        )?;
+        let valid = found.defects().is_empty() || out.triangle_count() == 0;
+        last = Some((out, grid.active_voxels()));
+        if valid {
+            break;
+        }
+    }
+    Ok(last.expect("at least one shift"))
+}
+
+/// `mesh` moved by `d` mm.
+fn translated(mesh: &Mesh, d: [f64; 3]) -> Mesh {
+    let mut m = mesh.clone();
+    for p in m.positions.chunks_exact_mut(3) {
+        for k in 0..3 {
+            p[k] = (p[k] as f64 + d[k]) as f32;
+        }
+    }
+    m
+}
+
+/// Drops facets left with a repeated vertex by welding, and the vertices no facet uses.
+fn drop_collapsed(mut mesh: Mesh) -> Mesh {
+    let mut kept = Vec::with_capacity(mesh.indices.len());
+    for t in mesh.indices.chunks_exact(3) {
+        if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+            kept.extend_from_slice(t);
+        }
+    }
+    mesh.indices = kept;
+    super::compact(&mut mesh);
+    mesh
+}
+
+/// Most active voxels an automatic voxel size may need (the narrow band is about six voxels
+/// thick): about 0.7 GB at the peak of a remesh, some 3 million facets out.
+const AUTO_MAX_ACTIVE: f64 = 1.0e7;
+
+/// The voxel size `--remesh auto` uses, mm: a quarter of the thinnest closed shell's mean
+/// thickness (2·volume/area: a plate's thickness, a rod's radius), and at most 1/64 of the
+/// part's largest extent; but no finer than keeps the narrow band (about six voxels thick over
+/// the surface) within [`AUTO_MAX_ACTIVE`] voxels, nor than 1/4000 of the extent.
+pub fn auto_voxel(mesh: &Mesh) -> f64 {
+    use crate::mesh::topology::{Shells, Topology};
+    let Some(b) = mesh.bounds() else {
+        return 1.0;
+    };
+    let extent = b.size().iter().fold(0.0f64, |m, x| m.max(*x));
+    if extent <= 0.0 {
+        return 1.0;
+    }
+    let topo = Topology::new(mesh);
+    let shells = Shells::new(mesh, &topo);
+    let mut area_total = 0.0;
+    let mut thinnest = f64::INFINITY;
+    for (members, edges) in shells.members.iter().zip(&shells.edges) {
+        let (mut vol, mut area) = (0.0, 0.0);
+        for &f in members {
+            let [a, b, c] = mesh.triangle(f as usize);
+            vol += crate::mesh::signed_volume(a, b, c);
+            area += 0.5
+                * crate::mesh::norm(crate::mesh::cross(
+                    crate::mesh::sub(b, a),
+                    crate::mesh::sub(c, a),
+                ));
+        }
+        area_total += area;
+        if edges.closed() && vol.abs() > 0.0 && area > 0.0 {
+            thinnest = thinnest.min(2.0 * vol.abs() / area);
+        }
+    }
+    let wanted = (thinnest / 4.0).min(extent / 64.0);
+    wanted
+        .max((6.0 * area_total / AUTO_MAX_ACTIVE).sqrt())
+        .max(extent / 4000.0)
 }

@@ -487,3 +487,17 @@ for line in sys.stdin:
     );
     v
 }
+
+/// The meshes of Debian's cura and prusa-slicer packages (printer beds, platforms, shapes),
+/// unpacked by scripts/install-deps.sh.
+pub fn slicer_mesh(package: &str, name: &str) -> std::path::PathBuf {
+    let p = Path::new("/usr/local/share/latvox/slicer-meshes")
+        .join(package)
+        .join(name);
+    assert!(
+        p.exists(),
+        "{} missing: run scripts/install-deps.sh (unpacks the slicers' meshes)",
+        p.display()
+    );
+    p
+}

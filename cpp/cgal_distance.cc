@@ -1,0 +1,83 @@
+// Distances from points to a triangle soup by CGAL's AABB tree (exact closest points on the
+// facets, in double precision), queried in parallel; optionally which points lie inside the
+// soup when it is a closed 2-manifold (Side_of_triangle_mesh, ray parity with exact
+// predicates). Measures how far a repaired or remeshed part moved from its input.
+#include "cgal.h"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Side_of_triangle_mesh.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/exceptions.h>
+
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "latvox/src/ffi/cgal.rs.h"
+
+namespace latvox {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Tri = K::Triangle_3;
+using Iter = std::vector<Tri>::const_iterator;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, CGAL::AABB_triangle_primitive<K, Iter>>>;
+using DMesh = CGAL::Surface_mesh<K::Point_3>;
+
+PointDistances cgal_distances(rust::Slice<const float> positions,
+                              rust::Slice<const uint32_t> indices,
+                              rust::Slice<const double> points, bool classify) {
+  if (positions.size() % 3 != 0 || indices.size() % 3 != 0 || points.size() % 3 != 0)
+    throw std::invalid_argument("positions, indices and points must come in triples");
+  const std::size_t nv = positions.size() / 3, nf = indices.size() / 3, np = points.size() / 3;
+  for (auto i : indices)
+    if (i >= nv) throw std::out_of_range("triangle index past the vertex list");
+  auto p = [&](std::size_t i) {
+    return K::Point_3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
+  };
+  std::vector<Tri> tris;
+  tris.reserve(nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    Tri t(p(indices[3 * f]), p(indices[3 * f + 1]), p(indices[3 * f + 2]));
+    if (!t.is_degenerate()) tris.push_back(t);
+  }
+  PointDistances out{};
+  if (tris.empty()) throw std::invalid_argument("no facet with an area to measure against");
+  Tree tree(tris.begin(), tris.end());
+  tree.accelerate_distance_queries();
+  std::vector<double> d(np);
+  tbb::parallel_for(std::size_t(0), np, [&](std::size_t i) {
+    const K::Point_3 q(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
+    d[i] = std::sqrt(CGAL::to_double(tree.squared_distance(q)));
+  });
+  out.distances.reserve(np);
+  for (double x : d) out.distances.push_back(x);
+  if (!classify) return out;
+  // Inside only means something for a closed 2-manifold: build one as given, or say nothing.
+  DMesh mesh;
+  for (std::size_t i = 0; i < nv; ++i) mesh.add_vertex(p(i));
+  for (std::size_t f = 0; f < nf; ++f) {
+    const DMesh::Vertex_index a(indices[3 * f]), b(indices[3 * f + 1]), c(indices[3 * f + 2]);
+    if (a == b || b == c || a == c || mesh.add_face(a, b, c) == DMesh::null_face()) return out;
+  }
+  if (!CGAL::is_closed(mesh)) return out;
+  try {
+    CGAL::Side_of_triangle_mesh<DMesh, K> side(mesh);
+    std::vector<char> in(np);
+    tbb::parallel_for(std::size_t(0), np, [&](std::size_t i) {
+      in[i] = side(K::Point_3(points[3 * i], points[3 * i + 1], points[3 * i + 2])) ==
+              CGAL::ON_BOUNDED_SIDE;
+    });
+    out.inside.reserve(np);
+    for (char x : in) out.inside.push_back(x != 0);
+  } catch (const CGAL::Failure_exception&) {
+    out.inside.clear();
+  }
+  return out;
+}
+
+}  // namespace latvox
