@@ -106,6 +106,14 @@ fn expanded_args() -> latvox::Result<Vec<String>> {
 }
 
 fn main() {
+    // A union for `repair --solid`, run apart so that it can be stopped (not a user command).
+    let raw: Vec<std::ffi::OsString> = std::env::args_os().collect();
+    if raw.len() == 4 && raw[1] == latvox::repair::solid::HELPER_ARG {
+        std::process::exit(latvox::repair::solid::helper(
+            std::path::Path::new(&raw[2]),
+            std::path::Path::new(&raw[3]),
+        ));
+    }
     let argv = expanded_args().unwrap_or_else(|e| {
         eprintln!("latvox: {}", one_line(&e));
         std::process::exit(e.exit_code());

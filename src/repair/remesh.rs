@@ -94,13 +94,14 @@ fn drop_collapsed(mut mesh: Mesh) -> Mesh {
 }
 
 /// Most active voxels an automatic voxel size may need (the narrow band is about six voxels
-/// thick): about 0.7 GB at the peak of a remesh, some 3 million facets out.
-const AUTO_MAX_ACTIVE: f64 = 1.0e7;
+/// thick): some 0.3 GB at the peak of a remesh, about a million facets out.
+const AUTO_MAX_ACTIVE: f64 = 4.0e6;
 
 /// The voxel size `--remesh auto` uses, mm: a quarter of the thinnest closed shell's mean
 /// thickness (2·volume/area: a plate's thickness, a rod's radius), and at most 1/64 of the
 /// part's largest extent; but no finer than keeps the narrow band (about six voxels thick over
-/// the surface) within [`AUTO_MAX_ACTIVE`] voxels, nor than 1/4000 of the extent.
+/// the surface) within [`AUTO_MAX_ACTIVE`] voxels, nor than 1/1000 of the extent (a shell crossing itself
+/// can have next to no signed volume).
 pub fn auto_voxel(mesh: &Mesh) -> f64 {
     use crate::mesh::topology::{Shells, Topology};
     let Some(b) = mesh.bounds() else {
@@ -133,5 +134,5 @@ pub fn auto_voxel(mesh: &Mesh) -> f64 {
     let wanted = (thinnest / 4.0).min(extent / 64.0);
     wanted
         .max((6.0 * area_total / AUTO_MAX_ACTIVE).sqrt())
-        .max(extent / 4000.0)
+        .max(extent / 1000.0)
 }

@@ -17,8 +17,8 @@
 //!    the last resort, always closed and manifold.
 //!
 //! CGAL 5.5's corefinement can loop for ever on some assemblies (parts sharing coplanar faces,
-//! seen on printer platforms even with exact constructions): it runs in a child process (fork)
-//! given a time limit, 5 s and 0.5 ms per facet; past it the child is killed and the group is
+//! seen on printer platforms even with exact constructions): it runs in a fresh `latvox` process
+//! given a time limit, 5 s and 0.5 ms per facet; past it the process is killed and the group is
 //! remeshed.
 //!
 //! Costs: one self-intersection search (a hierarchical grid, about n log n), corefinement of the
@@ -32,7 +32,6 @@ use crate::check::{check, CheckOptions};
 use crate::error::Error;
 use crate::error::Result;
 use crate::ffi::cgal::ffi;
-#[cfg(not(unix))]
 use crate::ffi::Backend;
 use crate::mesh::topology::{Shells, Topology, UnionFind};
 use crate::mesh::Mesh;
@@ -175,8 +174,13 @@ fn union_time_limit(facets: usize) -> Duration {
     Duration::from_secs_f64(5.0 + 5e-4 * facets as f64)
 }
 
+/// The hidden first argument that makes `latvox` run one union for [`union_within`] and exit.
+pub const HELPER_ARG: &str = "__corefine";
+
 /// The union of the shells of `sub` (`starts` as [`ffi::cgal_union`] takes them), or why there is
-/// none: CGAL's reason, or that it did not finish within `limit`.
+/// none: CGAL's reason, or that it did not finish within `limit`. The union runs in a fresh
+/// `latvox` process ([`helper`]) that is killed past the limit; without a `latvox` executable to
+/// run (the library inside another program) it runs here, with no limit.
 fn union_within(
     sub: &Mesh,
     starts: &[u32],
@@ -192,121 +196,151 @@ fn union_within(
             Err(u.reason)
         }
     };
-    #[cfg(not(unix))]
-    {
-        let _ = limit;
+    let Some(exe) = helper_exe() else {
         return Ok(as_mesh(
             ffi::cgal_union(&sub.positions, &sub.indices, starts).backend("CGAL corefinement")?,
         ));
+    };
+    let dir = tempfile::tempdir().map_err(|e| Error::io(std::env::temp_dir(), e))?;
+    let (input, output) = (dir.path().join("shells.bin"), dir.path().join("union.bin"));
+    std::fs::write(&input, encode_shells(sub, starts)).map_err(|e| Error::io(&input, e))?;
+    let spawned = std::process::Command::new(&exe)
+        .arg(HELPER_ARG)
+        .arg(&input)
+        .arg(&output)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn();
+    let mut child = match spawned {
+        Ok(c) => c,
+        Err(e) => return Err(Error::io(exe, e)),
+    };
+    let start = Instant::now();
+    let finished = loop {
+        match child.try_wait() {
+            Ok(Some(_)) => break true,
+            Ok(None) if start.elapsed() <= limit => std::thread::sleep(Duration::from_millis(2)),
+            _ => break false,
+        }
+    };
+    if !finished {
+        let _ = child.kill();
+        let _ = child.wait();
+        return Ok(Err(format!(
+            "CGAL's corefinement did not finish within {:.0} s",
+            limit.as_secs_f64()
+        )));
     }
-    #[cfg(unix)]
-    {
-        use std::sync::atomic::{AtomicU64, Ordering};
-        static NEXT: AtomicU64 = AtomicU64::new(0);
-        let path = std::env::temp_dir().join(format!(
-            "latvox-union-{}-{}.bin",
-            std::process::id(),
-            NEXT.fetch_add(1, Ordering::Relaxed)
-        ));
-        // SAFETY: the child only runs CGAL's single-threaded union on memory it inherited,
-        // writes one file and leaves with _exit (no destructors, no other thread's locks).
-        let pid = unsafe { libc::fork() };
-        if pid < 0 {
-            return Err(Error::Backend {
-                context: "CGAL corefinement",
-                message: "could not start a process".into(),
-            });
-        }
-        if pid == 0 {
-            let code = std::panic::catch_unwind(|| {
-                let bytes = match ffi::cgal_union(&sub.positions, &sub.indices, starts) {
-                    Ok(u) => encode(&u),
-                    Err(e) => encode(&ffi::ShellUnion {
-                        ok: false,
-                        reason: format!("CGAL's corefinement failed: {e}"),
-                        positions: Vec::new(),
-                        indices: Vec::new(),
-                    }),
-                };
-                std::fs::write(&path, bytes).is_ok()
-            });
-            // SAFETY: ends the child at once.
-            unsafe { libc::_exit(if matches!(code, Ok(true)) { 0 } else { 1 }) };
-        }
-        let start = Instant::now();
-        let mut status = 0;
-        let finished = loop {
-            // SAFETY: waits on our own child without blocking.
-            let r = unsafe { libc::waitpid(pid, &mut status, libc::WNOHANG) };
-            if r == pid {
-                break true;
-            }
-            if r < 0 || start.elapsed() > limit {
-                break false;
-            }
-            std::thread::sleep(Duration::from_millis(5));
-        };
-        if !finished {
-            // SAFETY: our own child, then reaped.
-            unsafe {
-                libc::kill(pid, libc::SIGKILL);
-                libc::waitpid(pid, &mut status, 0);
-            }
-            let _ = std::fs::remove_file(&path);
-            return Ok(Err(format!(
-                "CGAL's corefinement did not finish within {:.0} s",
-                limit.as_secs_f64()
-            )));
-        }
-        let bytes = std::fs::read(&path);
-        let _ = std::fs::remove_file(&path);
-        let decoded = bytes.ok().and_then(|b| decode(&b));
-        Ok(match decoded {
-            Some(u) => as_mesh(u),
-            None => Err("CGAL's corefinement ended without a result".to_string()),
-        })
+    Ok(match std::fs::read(&output).ok().and_then(|b| decode(&b)) {
+        Some(u) => as_mesh(u),
+        None => Err("CGAL's corefinement ended without a result".to_string()),
+    })
+}
+
+/// The `latvox` executable that runs unions: `LATVOX_EXE` if set, this program if it is latvox,
+/// else a `latvox` beside it or one folder up (cargo's test and bench programs sit in `deps/`).
+fn helper_exe() -> Option<std::path::PathBuf> {
+    if let Some(p) = std::env::var_os("LATVOX_EXE") {
+        return Some(p.into());
+    }
+    let me = std::env::current_exe().ok()?;
+    if me.file_stem().is_some_and(|s| s == "latvox") {
+        return Some(me);
+    }
+    let name = format!("latvox{}", std::env::consts::EXE_SUFFIX);
+    me.ancestors()
+        .skip(1)
+        .take(2)
+        .map(|d| d.join(&name))
+        .find(|p| p.is_file())
+}
+
+/// Runs one union for [`union_within`] (`latvox __corefine SHELLS UNION`): reads the shells,
+/// writes the union or CGAL's reason. Returns the exit code.
+pub fn helper(input: &std::path::Path, output: &std::path::Path) -> i32 {
+    let Some((sub, starts)) = std::fs::read(input).ok().and_then(|b| decode_shells(&b)) else {
+        return 2;
+    };
+    let u = match ffi::cgal_union(&sub.positions, &sub.indices, &starts) {
+        Ok(u) => u,
+        Err(e) => ffi::ShellUnion {
+            ok: false,
+            reason: format!("CGAL's corefinement failed: {e}"),
+            positions: Vec::new(),
+            indices: Vec::new(),
+        },
+    };
+    match std::fs::write(output, encode(&u)) {
+        Ok(()) => 0,
+        Err(_) => 3,
     }
 }
 
-/// A union as bytes: ok, the reason, the positions and the indices, each with its length.
-#[cfg(unix)]
+/// Little-endian words with their counts: a reader over bytes written by [`put`].
+struct Words<'a>(&'a [u8]);
+
+impl Words<'_> {
+    fn take(&mut self, n: usize) -> Option<&[u8]> {
+        let (head, tail) = (self.0.get(..n)?, self.0.get(n..)?);
+        self.0 = tail;
+        Some(head)
+    }
+    /// A counted run of `W`-byte words.
+    fn run<const W: usize, T>(&mut self, f: fn([u8; W]) -> T) -> Option<Vec<T>> {
+        let n = u64::from_le_bytes(self.take(8)?.try_into().ok()?) as usize;
+        let bytes = self.take(n.checked_mul(W)?)?;
+        Some(
+            bytes
+                .chunks_exact(W)
+                .map(|c| f(c.try_into().expect("W bytes")))
+                .collect(),
+        )
+    }
+}
+
+/// Appends the count of `xs` and their bytes.
+fn put<const W: usize, T: Copy>(b: &mut Vec<u8>, xs: &[T], f: fn(T) -> [u8; W]) {
+    b.extend((xs.len() as u64).to_le_bytes());
+    b.extend(xs.iter().flat_map(|&x| f(x)));
+}
+
+/// Shells for the helper: positions, indices, shell starts.
+fn encode_shells(sub: &Mesh, starts: &[u32]) -> Vec<u8> {
+    let mut b = Vec::new();
+    put(&mut b, &sub.positions, f32::to_le_bytes);
+    put(&mut b, &sub.indices, u32::to_le_bytes);
+    put(&mut b, starts, u32::to_le_bytes);
+    b
+}
+
+/// [`encode_shells`]'s inverse; `None` if the bytes are cut short.
+fn decode_shells(b: &[u8]) -> Option<(Mesh, Vec<u32>)> {
+    let mut w = Words(b);
+    let positions = w.run(f32::from_le_bytes)?;
+    let indices = w.run(u32::from_le_bytes)?;
+    let starts = w.run(u32::from_le_bytes)?;
+    Some((Mesh { positions, indices }, starts))
+}
+
+/// A union as bytes: ok, the reason, the positions and the indices.
 fn encode(u: &ffi::ShellUnion) -> Vec<u8> {
     let mut b = vec![u.ok as u8];
-    b.extend((u.reason.len() as u64).to_le_bytes());
-    b.extend(u.reason.as_bytes());
-    b.extend((u.positions.len() as u64).to_le_bytes());
-    b.extend(u.positions.iter().flat_map(|x| x.to_le_bytes()));
-    b.extend((u.indices.len() as u64).to_le_bytes());
-    b.extend(u.indices.iter().flat_map(|x| x.to_le_bytes()));
+    put(&mut b, u.reason.as_bytes(), |x: u8| [x]);
+    put(&mut b, &u.positions, f64::to_le_bytes);
+    put(&mut b, &u.indices, u32::to_le_bytes);
     b
 }
 
 /// [`encode`]'s inverse; `None` if the bytes are cut short.
-#[cfg(unix)]
 fn decode(b: &[u8]) -> Option<ffi::ShellUnion> {
-    let mut at = 1usize;
-    let mut take = |n: usize| {
-        let s = b.get(at..at + n)?;
-        at += n;
-        Some(s)
-    };
-    let len = |s: &[u8]| u64::from_le_bytes(s.try_into().expect("8 bytes")) as usize;
-    let n = len(take(8)?);
-    let reason = String::from_utf8_lossy(take(n)?).into_owned();
-    let n = len(take(8)?);
-    let positions = take(8 * n)?
-        .chunks_exact(8)
-        .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
-        .collect();
-    let n = len(take(8)?);
-    let indices = take(4 * n)?
-        .chunks_exact(4)
-        .map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
-        .collect();
+    let mut w = Words(b);
+    let ok = w.take(1)?[0] == 1;
+    let reason = String::from_utf8_lossy(&w.run(|[x]: [u8; 1]| x)?).into_owned();
     Some(ffi::ShellUnion {
-        ok: *b.first()? == 1,
+        ok,
         reason,
-        positions,
-        indices,
+        positions: w.run(f64::from_le_bytes)?,
+        indices: w.run(u32::from_le_bytes)?,
     })
 }

@@ -212,6 +212,10 @@ pub fn topo(tris: &[Tri]) -> Topo {
     for i in 0..faces.len() {
         shells.entry(find(&mut parent, i)).or_default().push(i);
     }
+    let mut back = vec![[0.0; 3]; id.len()];
+    for (k, &i) in &id {
+        back[i] = k.map(|b| f32::from_bits(b) as f64);
+    }
     for fs in shells.values() {
         let vs: HashSet<usize> = fs.iter().flat_map(|&f| faces[f]).collect();
         let es: HashSet<(usize, usize)> = fs
@@ -224,8 +228,8 @@ pub fn topo(tris: &[Tri]) -> Topo {
         let vol: f64 = fs
             .iter()
             .map(|&f| {
-                let tri = tris_of(&faces[f], &id);
-                det(tri)
+                let [a, b, c] = faces[f];
+                det([back[a], back[b], back[c]])
             })
             .sum();
         t.shells.push((fs.len(), vs.len(), es.len(), vol));
@@ -236,15 +240,6 @@ pub fn topo(tris: &[Tri]) -> Topo {
             .then(a.3.total_cmp(&b.3))
     });
     t
-}
-
-fn tris_of(f: &[usize; 3], id: &HashMap<[u32; 3], usize>) -> Tri {
-    let mut back = vec![[0.0; 3]; id.len()];
-    // (Slow but independent: rebuild positions from keys.)
-    for (k, &i) in id {
-        back[i] = k.map(|b| f32::from_bits(b) as f64);
-    }
-    [back[f[0]], back[f[1]], back[f[2]]]
 }
 
 pub fn det(t: Tri) -> f64 {
