@@ -1,7 +1,8 @@
 // CGAL side of the bridge, on indexed triangle soups: closed-mesh measures and validity checks
 // (cgal_check.cc); self-intersections of any soup and hole filling, the repair steps
 // (cgal_repair.cc, compiled apart with its own CGAL settings); the union of closed shells by
-// corefinement (cgal_boolean.cc); distances from points to a soup (cgal_distance.cc). One header for the whole library.
+// corefinement (cgal_boolean.cc); distances from points to a soup and rays from its facets
+// (cgal_distance.cc). One header for the whole library.
 #pragma once
 #include <cstdint>
 #include "rust/cxx.h"
@@ -36,5 +37,7 @@ ShellUnion cgal_union(rust::Slice<const float> positions, rust::Slice<const uint
 PointDistances cgal_distances(rust::Slice<const float> positions,
                               rust::Slice<const uint32_t> indices,
                               rust::Slice<const double> points, bool classify);
+rust::Vec<double> cgal_facet_reach(rust::Slice<const float> positions,
+                                   rust::Slice<const uint32_t> indices);
 
 }  // namespace latvox

@@ -1,7 +1,8 @@
 // Distances from points to a triangle soup by CGAL's AABB tree (exact closest points on the
 // facets, in double precision), queried in parallel; optionally which points lie inside the
 // soup when it is a closed 2-manifold (Side_of_triangle_mesh, ray parity with exact
-// predicates). Measures how far a repaired or remeshed part moved from its input.
+// predicates). Measures how far a repaired or remeshed part moved from its input; and how far
+// rays from each facet travel through the part and in front of it (its walls and gaps).
 #include "cgal.h"
 
 #include <CGAL/AABB_traits.h>
@@ -15,6 +16,7 @@
 #include <tbb/parallel_for.h>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -77,6 +79,61 @@ PointDistances cgal_distances(rust::Slice<const float> positions,
   } catch (const CGAL::Failure_exception&) {
     out.inside.clear();
   }
+  return out;
+}
+
+rust::Vec<double> cgal_facet_reach(rust::Slice<const float> positions,
+                                   rust::Slice<const uint32_t> indices) {
+  if (positions.size() % 3 != 0 || indices.size() % 3 != 0)
+    throw std::invalid_argument("positions and indices must come in triples");
+  const std::size_t nv = positions.size() / 3, nf = indices.size() / 3;
+  for (auto i : indices)
+    if (i >= nv) throw std::out_of_range("triangle index past the vertex list");
+  auto p = [&](std::size_t i) {
+    return K::Point_3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
+  };
+  std::vector<Tri> tris;
+  tris.reserve(nf);
+  for (std::size_t f = 0; f < nf; ++f)
+    tris.emplace_back(p(indices[3 * f]), p(indices[3 * f + 1]), p(indices[3 * f + 2]));
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> reach(nf, inf);
+  std::vector<Tri> solid;
+  std::vector<std::size_t> of;
+  for (std::size_t f = 0; f < nf; ++f)
+    if (!tris[f].is_degenerate()) {
+      solid.push_back(tris[f]);
+      of.push_back(f);
+    }
+  if (solid.empty()) {
+    rust::Vec<double> out;
+    for (double x : reach) out.push_back(x);
+    return out;
+  }
+  Tree tree(solid.begin(), solid.end());
+  tbb::parallel_for(std::size_t(0), solid.size(), [&](std::size_t i) {
+    const Tri& t = solid[i];
+    const K::Point_3 c = CGAL::centroid(t[0], t[1], t[2]);
+    const K::Vector_3 n = CGAL::normal(t[0], t[1], t[2]);
+    const Iter self = solid.begin() + static_cast<std::ptrdiff_t>(i);
+    auto skip = [&](const Iter& id) { return id == self; };
+    double best = inf;
+    for (const K::Vector_3& d : {n, -n}) {
+      try {
+        auto hit = tree.first_intersection(K::Ray_3(c, d), skip);
+        if (!hit) continue;
+        if (const K::Point_3* q = boost::get<K::Point_3>(&hit->first))
+          best = std::min(best, std::sqrt(CGAL::to_double(CGAL::squared_distance(c, *q))));
+        else if (const K::Segment_3* s = boost::get<K::Segment_3>(&hit->first))
+          best = std::min(best, std::sqrt(CGAL::to_double(CGAL::squared_distance(c, *s))));
+      } catch (const CGAL::Failure_exception&) {
+      }
+    }
+    reach[of[i]] = best;
+  });
+  rust::Vec<double> out;
+  out.reserve(nf);
+  for (double x : reach) out.push_back(x);
   return out;
 }
 

@@ -14,6 +14,7 @@
 pub mod cgal;
 pub mod deviation;
 mod file;
+pub mod reach;
 pub mod self_intersect;
 pub(crate) mod verdict;
 pub mod verify;

@@ -98,5 +98,10 @@ pub(crate) mod ffi {
             points: &[f64],
             classify: bool,
         ) -> Result<PointDistances>;
+
+        /// For each facet of the soup, how far a ray from its centroid along its normal and
+        /// against it travels before it meets another facet (the nearer; infinity if neither
+        /// does): the wall's thickness or the gap in front of it.
+        fn cgal_facet_reach(positions: &[f32], indices: &[u32]) -> Result<Vec<f64>>;
     }
 }
