@@ -10,7 +10,10 @@
 //! 4. The whole `latvox repair` command on the damaged copy (read, check, repair, write, read the
 //!    written file back and check it again), as a user runs it.
 //!
-//! Medians of several runs, wall time and (in-process) CPU time of all threads. Run: `cargo bench --bench check` (add `-- --runs N`).
+//! 5. `latvox repair --solid` on the damaged copy and on the worst slicer mesh of the test corpus
+//!    (wall time and peak memory of the command).
+//!
+//! Medians of several runs, wall time and (in-process) CPU time of all threads. Run: `cargo bench --bench check` (add `-- --runs N`; `-- --solid-only` for section 5 alone).
 
 use latvox::check::{check, CheckOptions};
 use latvox::io::{ReadOptions, StlFormat};
@@ -103,6 +106,10 @@ fn main() {
         .collect();
     let damaged_path = dir.path().join("torus-1m-damaged.stl");
     latvox::io::stl::save(&damaged, StlFormat::Binary, &damaged_path).unwrap();
+    if args.iter().any(|a| a == "--solid-only") {
+        solid_section(&damaged_path, runs);
+        return;
+    }
 
     println!("\n1. reading a {}-facet binary STL", clean.triangle_count());
     let (t_read, loaded) = time(runs, || {
@@ -232,15 +239,29 @@ fn main() {
     });
     println!("  latvox repair (read, check, repair, write, re-read, check)  {t_cli:.3} s");
 
+    solid_section(&damaged_path, runs);
+}
+
+/// 5. `repair --solid` on the damaged part and on the worst slicer mesh, as a user runs it.
+fn solid_section(damaged_path: &std::path::Path, runs: usize) {
+    let exe = env!("CARGO_BIN_EXE_latvox");
+    let dir = tempfile::tempdir().unwrap();
     println!(
         "\n5. latvox repair --solid (wall time and peak memory of the command, /usr/bin/time)"
     );
-    let worst = std::path::Path::new(
-        "/usr/local/share/latvox/slicer-meshes/cura/bq_hephestos_2_platform.3mf",
+    let cura = std::path::Path::new("/usr/local/share/latvox/slicer-meshes/cura");
+    let (bq, bee) = (
+        cura.join("bq_hephestos_2_platform.3mf"),
+        cura.join("BEEVERYCREATIVE-helloBEEprusa.3mf"),
     );
+    // The two slowest of the slicer corpus (unions that do not finish, groups remeshed).
     for (name, input) in [
-        ("the damaged 1 M-facet part", damaged_path.as_path()),
-        ("bq_hephestos_2_platform.3mf (Debian's cura)", worst),
+        ("the damaged 1 M-facet part", damaged_path),
+        ("bq_hephestos_2_platform.3mf (Debian's cura)", bq.as_path()),
+        (
+            "BEEVERYCREATIVE-helloBEEprusa.3mf (Debian's cura)",
+            bee.as_path(),
+        ),
     ] {
         if !input.exists() {
             println!("  {name}: missing (scripts/install-deps.sh unpacks the slicers' meshes)");

@@ -363,13 +363,7 @@ while it.MoveNext():
                 "sets": bl.GetBeamSetCount(), "radii": sorted(radii), "caps": sorted(caps)})
 print(json.dumps(out))
 "#;
-    let o = std::process::Command::new("python3")
-        .args(["-c", SCRIPT])
-        .arg(path)
-        .output()
-        .expect("python3 with lib3mf (scripts/install-deps.sh installs it)");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    serde_json::from_slice(&o.stdout).unwrap()
+    serde_json::from_slice(&common::python(SCRIPT, path)).unwrap()
 }
 
 #[test]

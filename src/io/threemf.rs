@@ -45,12 +45,21 @@ fn apply(m: &Transform, p: [f32; 3]) -> [f32; 3] {
     [0, 1, 2].map(|c| (x * m[c] + y * m[3 + c] + z * m[6 + c] + m[9 + c]) as f32)
 }
 
+/// An object's key: the model part that holds it (its path in the package, no leading slash) and
+/// its id there.
+type Key = (String, u64);
+
 #[derive(Default)]
 struct Object {
     positions: Vec<f32>,
     triangles: Vec<u32>,
-    components: Vec<(u64, Transform)>,
+    components: Vec<(Key, Transform)>,
+    /// Beams of the Beam Lattice extension (not read as geometry).
+    beams: u64,
 }
+
+/// Most model parts a package may reference (Production extension).
+const MAX_PARTS: usize = 100_000;
 
 fn attr(e: &BytesStart, name: &str) -> Result<Option<String>> {
     for a in e.attributes() {
@@ -137,22 +146,160 @@ fn model_path(zip: &mut zip::ZipArchive<Cursor<&[u8]>>) -> String {
     fallback
 }
 
-/// Parses a 3MF package.
+/// A part's path as a key: `p:path` values are absolute within the package.
+fn part_key(path: &str) -> String {
+    path.trim_start_matches('/').to_string()
+}
+
+/// Parses a 3MF package: the root model part, and the model parts its build items and components
+/// name by the Production extension's `p:path`, each in its own unit.
 pub fn parse(data: &[u8]) -> Result<Parsed> {
     let mut zip = zip::ZipArchive::new(Cursor::new(data))
         .map_err(|e| Error::parse(format!("not a zip package: {e}")))?;
-    let path = model_path(&mut zip);
-    let xml = read_entry(&mut zip, &path)?;
-    let text = std::str::from_utf8(&xml).map_err(|_| Error::parse("model XML is not UTF-8"))?;
-    let mut r = quick_xml::Reader::from_str(text);
-    let mut objects: HashMap<u64, Object> = HashMap::new();
-    let mut items: Vec<(u64, Transform)> = Vec::new();
-    let mut current: Option<u64> = None;
-    let mut scale = 1.0f64;
+    let root = part_key(&model_path(&mut zip));
+    let mut objects: HashMap<Key, Object> = HashMap::new();
+    let mut items: Vec<(Key, Transform)> = Vec::new();
     let mut stored_triangles = 0u64;
+    let mut todo = vec![root.clone()];
+    let mut seen: std::collections::HashSet<String> = todo.iter().cloned().collect();
+    let mut bytes = 0u64;
+    while let Some(part) = todo.pop() {
+        let xml = read_entry(&mut zip, &part)?;
+        bytes += xml.len() as u64;
+        if bytes > MAX_MODEL_BYTES {
+            return Err(Error::parse("model parts larger than 4 GiB in all"));
+        }
+        let named = parse_part(
+            &xml,
+            &part,
+            (part == root).then_some(&mut items),
+            &mut objects,
+            &mut stored_triangles,
+        )?;
+        for p in named {
+            if seen.len() >= MAX_PARTS {
+                return Err(Error::parse(format!(
+                    "more than {MAX_PARTS} model parts referenced"
+                )));
+            }
+            if seen.insert(p.clone()) {
+                todo.push(p);
+            }
+        }
+    }
+    if items.is_empty() {
+        return Err(Error::parse("no <build> <item>"));
+    }
+    // Triangles after instancing, computed before copying anything.
+    fn count(objects: &HashMap<Key, Object>, key: &Key, depth: usize) -> Result<(u64, u64)> {
+        if depth > MAX_DEPTH {
+            return Err(Error::parse("components nested too deeply (or in a cycle)"));
+        }
+        let o = objects.get(key).ok_or_else(|| {
+            Error::parse(format!(
+                "reference to undefined object {} in /{}",
+                key.1, key.0
+            ))
+        })?;
+        let (mut n, mut beams) = ((o.triangles.len() / 3) as u64, o.beams);
+        for (c, _) in &o.components {
+            let (cn, cb) = count(objects, c, depth + 1)?;
+            n = n.saturating_add(cn);
+            beams = beams.saturating_add(cb);
+        }
+        Ok((n, beams))
+    }
+    let (mut total, mut beams) = (0u64, 0u64);
+    for (key, _) in &items {
+        let (n, b) = count(&objects, key, 0)?;
+        total = total.saturating_add(n);
+        beams = beams.saturating_add(b);
+    }
+    if beams > 0 {
+        return Err(Error::parse(format!(
+            "{beams} beams of the 3MF Beam Lattice extension: beam lattices are not read as solids yet (export the lattice as a mesh)"
+        )));
+    }
+    let cap = 20_000_000 + 16 * stored_triangles;
+    if total > cap {
+        return Err(Error::parse(format!(
+            "build expands {stored_triangles} stored triangles to {total}, over the limit of {cap}"
+        )));
+    }
+    fn emit(
+        objects: &HashMap<Key, Object>,
+        key: &Key,
+        m: &Transform,
+        sink: &mut PolygonSink,
+    ) -> Result<()> {
+        let o = &objects[key];
+        let base = sink.vertex_count() as u32;
+        for p in o.positions.chunks_exact(3) {
+            sink.push_vertex(apply(m, [p[0], p[1], p[2]]))?;
+        }
+        for t in o.triangles.chunks_exact(3) {
+            for &i in t {
+                sink.corner(base + i);
+            }
+            sink.end_face()?;
+        }
+        for (c, t) in &o.components {
+            emit(objects, c, &compose(t, m), sink)?;
+        }
+        Ok(())
+    }
+    let mut sink = PolygonSink::new();
+    for (key, t) in &items {
+        emit(&objects, key, t, &mut sink)?;
+    }
+    sink.finish()
+}
+
+/// The object being read, for an `element` that belongs inside one.
+fn open<'a>(
+    objects: &'a mut HashMap<Key, Object>,
+    current: &Option<Key>,
+    element: &str,
+) -> Result<&'a mut Object> {
+    current
+        .as_ref()
+        .and_then(|k| objects.get_mut(k))
+        .ok_or_else(|| Error::parse(format!("<{element}> outside an <object>")))
+}
+
+/// Reads the objects of the model part `part` into `objects`, and its build items into `items`
+/// (the root part only). Returns the other parts its items and components name (`p:path`).
+fn parse_part(
+    xml: &[u8],
+    part: &str,
+    mut items: Option<&mut Vec<(Key, Transform)>>,
+    objects: &mut HashMap<Key, Object>,
+    stored_triangles: &mut u64,
+) -> Result<Vec<String>> {
+    let text = std::str::from_utf8(xml)
+        .map_err(|_| Error::parse(format!("model part /{part} is not UTF-8")))?;
+    let mut r = quick_xml::Reader::from_str(text);
+    let mut named = Vec::new();
+    let mut current: Option<Key> = None;
+    let mut scale = 1.0f64;
+    // The part an item or component names: its own unless `p:path` says otherwise.
+    let target = |e: &BytesStart, named: &mut Vec<String>| -> Result<Key> {
+        let id: u64 = num(e, "objectid")?;
+        Ok(match attr(e, "path")? {
+            Some(p) if part_key(&p) != part => {
+                let p = part_key(&p);
+                named.push(p.clone());
+                (p, id)
+            }
+            _ => (part.to_string(), id),
+        })
+    };
     loop {
         let ev = r.read_event().map_err(|e| {
-            Error::parse(format!("model XML: {e} (at byte {})", r.buffer_position()))
+            Error::parse(format!(
+                "model XML /{part}: {e} (at byte {})",
+                r.buffer_position()
+            ))
         })?;
         let (e, empty) = match ev {
             Event::Start(e) => (e, false),
@@ -184,30 +331,28 @@ pub fn parse(data: &[u8]) -> Result<Parsed> {
                 };
             }
             "object" => {
-                let id: u64 = num(&e, "id")?;
-                if objects.contains_key(&id) {
-                    return Err(Error::parse(format!("object id {id} defined twice")));
+                let key = (part.to_string(), num(&e, "id")?);
+                if objects.contains_key(&key) {
+                    return Err(Error::parse(format!(
+                        "object id {} defined twice in /{part}",
+                        key.1
+                    )));
                 }
-                objects.insert(id, Object::default());
-                current = (!empty).then_some(id);
+                objects.insert(key.clone(), Object::default());
+                current = (!empty).then_some(key);
             }
             "vertex" => {
-                let id = current.ok_or_else(|| Error::parse("<vertex> outside an <object>"))?;
-                let o = objects
-                    .get_mut(&id)
-                    .ok_or_else(|| Error::parse("<vertex> outside an <object>"))?;
                 let p: [f32; 3] = [num(&e, "x")?, num(&e, "y")?, num(&e, "z")?];
                 if !p.iter().all(|v| v.is_finite()) {
                     return Err(Error::parse(format!("non-finite vertex coordinate {p:?}")));
                 }
-                o.positions.extend(p.map(|v| (v as f64 * scale) as f32));
+                open(objects, &current, "vertex")?
+                    .positions
+                    .extend(p.map(|v| (v as f64 * scale) as f32));
             }
             "triangle" => {
-                let id = current.ok_or_else(|| Error::parse("<triangle> outside an <object>"))?;
-                let o = objects
-                    .get_mut(&id)
-                    .ok_or_else(|| Error::parse("<triangle> outside an <object>"))?;
                 let t: [u32; 3] = [num(&e, "v1")?, num(&e, "v2")?, num(&e, "v3")?];
+                let o = open(objects, &current, "triangle")?;
                 let nv = o.positions.len() / 3;
                 if t.iter().any(|&i| i as usize >= nv) {
                     return Err(Error::parse(format!(
@@ -215,74 +360,27 @@ pub fn parse(data: &[u8]) -> Result<Parsed> {
                     )));
                 }
                 o.triangles.extend_from_slice(&t);
-                stored_triangles += 1;
+                *stored_triangles += 1;
             }
+            "beam" => open(objects, &current, "beam")?.beams += 1,
             "component" => {
-                let id = current.ok_or_else(|| Error::parse("<component> outside an <object>"))?;
-                let o = objects
-                    .get_mut(&id)
-                    .ok_or_else(|| Error::parse("<component> outside an <object>"))?;
-                o.components
-                    .push((num(&e, "objectid")?, transform(&e, scale)?));
+                let key = target(&e, &mut named)?;
+                let t = transform(&e, scale)?;
+                open(objects, &current, "component")?
+                    .components
+                    .push((key, t));
             }
-            "item" => items.push((num(&e, "objectid")?, transform(&e, scale)?)),
+            "item" => {
+                let key = target(&e, &mut named)?;
+                let t = transform(&e, scale)?;
+                if let Some(items) = items.as_deref_mut() {
+                    items.push((key, t));
+                }
+            }
             _ => {}
         }
     }
-    if items.is_empty() {
-        return Err(Error::parse("no <build> <item>"));
-    }
-    // Triangles after instancing, computed before copying anything.
-    fn count(objects: &HashMap<u64, Object>, id: u64, depth: usize) -> Result<u64> {
-        if depth > MAX_DEPTH {
-            return Err(Error::parse("components nested too deeply (or in a cycle)"));
-        }
-        let o = objects
-            .get(&id)
-            .ok_or_else(|| Error::parse(format!("reference to undefined object {id}")))?;
-        let mut n = (o.triangles.len() / 3) as u64;
-        for (c, _) in &o.components {
-            n = n.saturating_add(count(objects, *c, depth + 1)?);
-        }
-        Ok(n)
-    }
-    let mut total = 0u64;
-    for (id, _) in &items {
-        total = total.saturating_add(count(&objects, *id, 0)?);
-    }
-    let cap = 20_000_000 + 16 * stored_triangles;
-    if total > cap {
-        return Err(Error::parse(format!(
-            "build expands {stored_triangles} stored triangles to {total}, over the limit of {cap}"
-        )));
-    }
-    fn emit(
-        objects: &HashMap<u64, Object>,
-        id: u64,
-        m: &Transform,
-        sink: &mut PolygonSink,
-    ) -> Result<()> {
-        let o = &objects[&id];
-        let base = sink.vertex_count() as u32;
-        for p in o.positions.chunks_exact(3) {
-            sink.push_vertex(apply(m, [p[0], p[1], p[2]]))?;
-        }
-        for t in o.triangles.chunks_exact(3) {
-            for &i in t {
-                sink.corner(base + i);
-            }
-            sink.end_face()?;
-        }
-        for (c, t) in &o.components {
-            emit(objects, *c, &compose(t, m), sink)?;
-        }
-        Ok(())
-    }
-    let mut sink = PolygonSink::new();
-    for (id, t) in &items {
-        emit(&objects, *id, t, &mut sink)?;
-    }
-    sink.finish()
+    Ok(named)
 }
 
 /// The package's fixed parts, and the model XML up to its first vertex / after its last triangle.

@@ -238,6 +238,18 @@ pub fn assert_refusal(dir: &Path, before: &[PathBuf], out: &Output, args: &[&str
     assert_eq!(files_in(dir), before, "{args:?} left a file");
 }
 
+/// Runs a Python `script` (the independent checkers: lib3mf, trimesh, manifold3d) on `path`;
+/// its standard output.
+pub fn python(script: &str, path: &Path) -> Vec<u8> {
+    let o = Command::new("python3")
+        .args(["-c", script])
+        .arg(path)
+        .output()
+        .expect("python3 with the checkers (scripts/install-deps.sh installs them)");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o.stdout
+}
+
 pub fn tempdir() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
 }
