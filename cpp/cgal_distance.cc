@@ -30,12 +30,13 @@ using Iter = std::vector<Tri>::const_iterator;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, CGAL::AABB_triangle_primitive<K, Iter>>>;
 using DMesh = CGAL::Surface_mesh<K::Point_3>;
 
-PointDistances cgal_distances(rust::Slice<const float> positions,
-                              rust::Slice<const uint32_t> indices,
-                              rust::Slice<const double> points, bool classify) {
-  if (positions.size() % 3 != 0 || indices.size() % 3 != 0 || points.size() % 3 != 0)
-    throw std::invalid_argument("positions, indices and points must come in triples");
-  const std::size_t nv = positions.size() / 3, nf = indices.size() / 3, np = points.size() / 3;
+// The facets of a soup that have an area, as triangles, and (in `of`) the index of each in the
+// soup; checks the arrays first.
+static std::vector<Tri> soup(rust::Slice<const float> positions,
+                             rust::Slice<const uint32_t> indices, std::vector<std::size_t>& of) {
+  if (positions.size() % 3 != 0 || indices.size() % 3 != 0)
+    throw std::invalid_argument("positions and indices must come in triples");
+  const std::size_t nv = positions.size() / 3, nf = indices.size() / 3;
   for (auto i : indices)
     if (i >= nv) throw std::out_of_range("triangle index past the vertex list");
   auto p = [&](std::size_t i) {
@@ -45,8 +46,24 @@ PointDistances cgal_distances(rust::Slice<const float> positions,
   tris.reserve(nf);
   for (std::size_t f = 0; f < nf; ++f) {
     Tri t(p(indices[3 * f]), p(indices[3 * f + 1]), p(indices[3 * f + 2]));
-    if (!t.is_degenerate()) tris.push_back(t);
+    if (!t.is_degenerate()) {
+      tris.push_back(t);
+      of.push_back(f);
+    }
   }
+  return tris;
+}
+
+PointDistances cgal_distances(rust::Slice<const float> positions,
+                              rust::Slice<const uint32_t> indices,
+                              rust::Slice<const double> points, bool classify) {
+  if (points.size() % 3 != 0) throw std::invalid_argument("points must come in triples");
+  const std::size_t nv = positions.size() / 3, nf = indices.size() / 3, np = points.size() / 3;
+  auto p = [&](std::size_t i) {
+    return K::Point_3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
+  };
+  std::vector<std::size_t> of;
+  const std::vector<Tri> tris = soup(positions, indices, of);
   PointDistances out{};
   if (tris.empty()) throw std::invalid_argument("no facet with an area to measure against");
   Tree tree(tris.begin(), tris.end());
@@ -84,27 +101,11 @@ PointDistances cgal_distances(rust::Slice<const float> positions,
 
 rust::Vec<double> cgal_facet_reach(rust::Slice<const float> positions,
                                    rust::Slice<const uint32_t> indices) {
-  if (positions.size() % 3 != 0 || indices.size() % 3 != 0)
-    throw std::invalid_argument("positions and indices must come in triples");
-  const std::size_t nv = positions.size() / 3, nf = indices.size() / 3;
-  for (auto i : indices)
-    if (i >= nv) throw std::out_of_range("triangle index past the vertex list");
-  auto p = [&](std::size_t i) {
-    return K::Point_3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
-  };
-  std::vector<Tri> tris;
-  tris.reserve(nf);
-  for (std::size_t f = 0; f < nf; ++f)
-    tris.emplace_back(p(indices[3 * f]), p(indices[3 * f + 1]), p(indices[3 * f + 2]));
+  const std::size_t nf = indices.size() / 3;
+  std::vector<std::size_t> of;
+  const std::vector<Tri> solid = soup(positions, indices, of);
   const double inf = std::numeric_limits<double>::infinity();
   std::vector<double> reach(nf, inf);
-  std::vector<Tri> solid;
-  std::vector<std::size_t> of;
-  for (std::size_t f = 0; f < nf; ++f)
-    if (!tris[f].is_degenerate()) {
-      solid.push_back(tris[f]);
-      of.push_back(f);
-    }
   if (solid.empty()) {
     rust::Vec<double> out;
     for (double x : reach) out.push_back(x);
