@@ -190,10 +190,20 @@ pub fn parse(data: &[u8]) -> Result<Parsed> {
     if items.is_empty() {
         return Err(Error::parse("no <build> <item>"));
     }
-    // Triangles after instancing, computed before copying anything.
-    fn count(objects: &HashMap<Key, Object>, key: &Key, depth: usize) -> Result<(u64, u64)> {
+    // Triangles, beams and object instances after instancing, computed before copying anything
+    // (once per object: components that share objects cost nothing more).
+    type Counts = (u64, u64, u64);
+    fn count(
+        objects: &HashMap<Key, Object>,
+        key: &Key,
+        depth: usize,
+        memo: &mut HashMap<Key, Counts>,
+    ) -> Result<Counts> {
         if depth > MAX_DEPTH {
             return Err(Error::parse("components nested too deeply (or in a cycle)"));
+        }
+        if let Some(c) = memo.get(key) {
+            return Ok(*c);
         }
         let o = objects.get(key).ok_or_else(|| {
             Error::parse(format!(
@@ -201,23 +211,36 @@ pub fn parse(data: &[u8]) -> Result<Parsed> {
                 key.1, key.0
             ))
         })?;
-        let (mut n, mut beams) = ((o.triangles.len() / 3) as u64, o.beams);
+        let mut n = ((o.triangles.len() / 3) as u64, o.beams, 1u64);
         for (c, _) in &o.components {
-            let (cn, cb) = count(objects, c, depth + 1)?;
-            n = n.saturating_add(cn);
-            beams = beams.saturating_add(cb);
+            let (cn, cb, ci) = count(objects, c, depth + 1, memo)?;
+            n = (
+                n.0.saturating_add(cn),
+                n.1.saturating_add(cb),
+                n.2.saturating_add(ci),
+            );
         }
-        Ok((n, beams))
+        memo.insert(key.clone(), n);
+        Ok(n)
     }
-    let (mut total, mut beams) = (0u64, 0u64);
+    let (mut total, mut beams, mut instances) = (0u64, 0u64, 0u64);
+    let mut memo = HashMap::new();
     for (key, _) in &items {
-        let (n, b) = count(&objects, key, 0)?;
+        let (n, b, i) = count(&objects, key, 0, &mut memo)?;
         total = total.saturating_add(n);
         beams = beams.saturating_add(b);
+        instances = instances.saturating_add(i);
     }
     if beams > 0 {
         return Err(Error::parse(format!(
             "{beams} beams of the 3MF Beam Lattice extension: beam lattices are not read as solids yet (export the lattice as a mesh)"
+        )));
+    }
+    let placed = 1_000_000 + 16 * objects.len() as u64;
+    if instances > placed {
+        return Err(Error::parse(format!(
+            "build places {} objects {instances} times, over the limit of {placed}",
+            objects.len()
         )));
     }
     let cap = 20_000_000 + 16 * stored_triangles;
@@ -689,6 +712,36 @@ mod tests {
         };
         assert!(write(&degenerate, &mut Vec::new()).is_err());
     }
+
+    /// Objects that each hold ten instances of the next, sixteen deep: 10¹⁵ instances from a
+    /// few kilobytes. Refused at once (counting visits each object once), with or without
+    /// triangles at the bottom.
+    #[test]
+    fn deep_shared_components_are_counted_once_and_refused() {
+        for leaf in ["<mesh><vertices/><triangles/></mesh>", TETRA] {
+            let mut model = String::from("<model unit=\"millimeter\"><resources>");
+            model += &format!("<object id=\"16\">{leaf}</object>");
+            for id in (0..16).rev() {
+                model += &format!("<object id=\"{id}\"><components>");
+                for _ in 0..10 {
+                    model += &format!("<component objectid=\"{}\"/>", id + 1);
+                }
+                model += "</components></object>";
+            }
+            model += "</resources><build><item objectid=\"0\"/></build></model>";
+            let mut b = Vec::new();
+            package(&mut b, |w| w.write_all(model.as_bytes())).unwrap();
+            let t = std::time::Instant::now();
+            let e = parse(&b).map(|_| ()).unwrap_err().to_string();
+            assert!(e.contains("over the limit"), "{e}");
+            assert!(t.elapsed().as_secs() < 5, "{:?}", t.elapsed());
+        }
+    }
+
+    const TETRA: &str = "<mesh><vertices><vertex x=\"0\" y=\"0\" z=\"0\"/><vertex x=\"1\" y=\"0\" z=\"0\"/>\
+        <vertex x=\"0\" y=\"1\" z=\"0\"/><vertex x=\"0\" y=\"0\" z=\"1\"/></vertices><triangles>\
+        <triangle v1=\"0\" v2=\"2\" v3=\"1\"/><triangle v1=\"0\" v2=\"1\" v3=\"3\"/>\
+        <triangle v1=\"0\" v2=\"3\" v3=\"2\"/><triangle v1=\"1\" v2=\"2\" v3=\"3\"/></triangles></mesh>";
 
     #[test]
     fn units_components_and_build_transforms_compose() {
