@@ -156,7 +156,7 @@ fn main() {
                 None,
                 &CheckOptions {
                     self_intersections: false,
-                    tolerance: 0.0,
+                    ..CheckOptions::default()
                 },
             )
             .unwrap()

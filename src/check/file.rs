@@ -54,13 +54,15 @@ pub struct FileCheckReport {
 }
 
 /// Reads the mesh file `path` to be checked: vertices closer than `opts.tolerance` merge, as
-/// they count as lying on an edge when checking.
+/// they count as lying on an edge when checking; beam lattices are meshed into solids (see
+/// [`crate::mesh::part`]).
 pub fn read_file(path: &Path, opts: &CheckOptions, progress: &Progress) -> Result<Loaded> {
     let _s = progress.stage("reading");
     let read = ReadOptions {
         weld_tolerance: opts.tolerance,
+        beam_voxel: opts.beam_voxel,
     };
-    crate::io::read(path, &read)
+    crate::mesh::part::read(path, &read)
 }
 
 /// Reads and checks the mesh file `path` (see [`read_file`]).

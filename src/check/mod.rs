@@ -44,6 +44,8 @@ pub struct CheckOptions {
     pub self_intersections: bool,
     /// Also treat vertices within this distance (mm) of an edge as lying on it.
     pub tolerance: f64,
+    /// Voxel for meshing the beam lattices of a 3MF file, mm (automatic when `None`).
+    pub beam_voxel: Option<f64>,
 }
 
 impl Default for CheckOptions {
@@ -51,6 +53,7 @@ impl Default for CheckOptions {
         CheckOptions {
             self_intersections: true,
             tolerance: 0.0,
+            beam_voxel: None,
         }
     }
 }

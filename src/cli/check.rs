@@ -49,6 +49,11 @@ pub struct CheckFlags {
     /// Skip the self-intersection search (the costliest check).
     #[arg(long)]
     pub no_self_intersection: bool,
+    /// Voxel (mm) on which the beam lattices of a 3MF file are meshed into solids [default: a
+    /// sixth of the thinnest beam's radius, coarser only if the part would pass 2·10⁷ active
+    /// voxels].
+    #[arg(long, value_name = "MM", value_parser = super::parse_positive)]
+    pub beam_voxel: Option<f64>,
 }
 
 impl CheckFlags {
@@ -57,6 +62,7 @@ impl CheckFlags {
         CheckOptions {
             self_intersections: !self.no_self_intersection,
             tolerance: self.weld_tolerance,
+            beam_voxel: self.beam_voxel,
         }
     }
 }

@@ -175,6 +175,7 @@ impl SliceArgs {
             check: CheckOptions {
                 self_intersections: self.self_intersections,
                 tolerance: self.weld_tolerance,
+                beam_voxel: None,
             },
         })
     }

@@ -6,6 +6,7 @@
 //! clearance never overestimates, a skipped block can never hide a piece of surface (a skipped
 //! block that the surface crossed would be a hole in the mesh).
 
+pub mod beams;
 pub mod cellmap;
 pub mod density;
 pub mod domain;

@@ -24,29 +24,10 @@
 
 use crate::error::Result;
 use crate::field::{intersection_clearance, smooth_min, union_clearance, Aabb, Field, Vec3};
-use crate::grid::{Grid, GridSpec};
+use crate::grid::{distance_clearance, Grid, GridSpec, SPARE_VOXELS};
 use crate::mesh::pipeline::{Family, Solid, HALF_WIDTH};
 use crate::mesh::Mesh;
 use std::sync::Arc;
-
-/// The trilinear interpolation of a distance field's samples changes by at most √3 per mm (each
-/// axis' slope is at most 1): a value's magnitude over this bounds the distance to its zero set.
-const TRILINEAR_LIPSCHITZ: f64 = 1.75;
-
-/// A lower bound on the distance from a point to the zero set of a distance grid interpolated
-/// trilinearly, from the interpolated value `d` there, on voxels of `voxel` mm: `|d|/√3` (the
-/// interpolant's slope), or `|d| − √3·voxel` (the interpolant is within half a voxel diagonal
-/// of the true distance, which is 1-Lipschitz, at the point and on the zero set) — the samples
-/// being the distance where the grid is exact, a bound of the same sign beyond its bands.
-fn grid_clearance(d: f64, voxel: f64) -> f64 {
-    (d.abs() / TRILINEAR_LIPSCHITZ).max(d.abs() - TRILINEAR_LIPSCHITZ * voxel)
-}
-
-/// Voxels of exact distance kept beyond what the field reads (the band, the skin, the blend):
-/// enough that, beyond them, [`grid_clearance`] clears a whole leaf block and its band (a
-/// block's half diagonal, 3.5·√3 voxels, and the band's 3), so that the blocks wholly inside
-/// or outside the part are skipped, not sampled.
-const SPARE_VOXELS: f64 = 10.0;
 
 /// The part and the solids kept whole, as distance grids on one voxel size.
 pub struct Shape {
@@ -335,19 +316,23 @@ impl<S: Solid> FillField<'_, S> {
         let s = self.solid;
         let p = s.shape.part.value_at(x);
         let h = s.shape.voxel;
-        let cp = grid_clearance(p, h);
+        let cp = distance_clearance(p, h);
         let inner = match &s.infill {
             Infill::Full => cp,
             Infill::Empty => {
                 let core = -p - s.skin;
-                intersection_clearance(p, cp, core, grid_clearance(core, h))
+                intersection_clearance(p, cp, core, distance_clearance(core, h))
             }
             Infill::Lattice(_) => {
                 let f = self.lattice.as_ref().expect("a lattice has a field");
                 let (l, cl) = (f.value(x), f.clearance(x));
                 let core = -p - s.skin;
-                let (sv, cs) =
-                    skin_or_lattice((core, grid_clearance(core, h)), (l, cl), s.skin, s.blend);
+                let (sv, cs) = skin_or_lattice(
+                    (core, distance_clearance(core, h)),
+                    (l, cl),
+                    s.skin,
+                    s.blend,
+                );
                 intersection_clearance(p, cp, sv, cs)
             }
         };
@@ -361,7 +346,7 @@ impl<S: Solid> FillField<'_, S> {
             self.lattice.as_ref().map_or(f64::INFINITY, |f| f.value(x)),
             f64::INFINITY,
         );
-        union_clearance(v, inner, k, grid_clearance(k, h))
+        union_clearance(v, inner, k, distance_clearance(k, h))
     }
 
     fn undrilled_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {

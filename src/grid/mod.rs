@@ -24,6 +24,7 @@ mod to_mesh;
 mod values;
 mod write;
 
+pub use probe::{distance_clearance, SPARE_VOXELS};
 pub use read::read_values;
 pub use write::write_vdb_grids;
 

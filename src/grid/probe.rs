@@ -4,6 +4,25 @@
 use super::Grid;
 use crate::ffi::vdb::ffi;
 
+/// The trilinear interpolation of a distance field's samples changes by at most √3 per mm (each
+/// axis' slope is at most 1): a value's magnitude over this bounds the distance to its zero set.
+const TRILINEAR_LIPSCHITZ: f64 = 1.75;
+
+/// A lower bound on the distance from a point to the zero set of a distance grid interpolated
+/// trilinearly, from the interpolated value `d` there, on voxels of `voxel` mm: `|d|/√3` (the
+/// interpolant's slope), or `|d| − √3·voxel` (the interpolant is within half a voxel diagonal
+/// of the true distance, which is 1-Lipschitz, at the point and on the zero set) — the samples
+/// being the distance where the grid is exact, a bound of the same sign beyond its bands.
+pub fn distance_clearance(d: f64, voxel: f64) -> f64 {
+    (d.abs() / TRILINEAR_LIPSCHITZ).max(d.abs() - TRILINEAR_LIPSCHITZ * voxel)
+}
+
+/// Voxels of exact distance kept beyond what the field reads (the band, the skin, the blend):
+/// enough that, beyond them, [`distance_clearance`] clears a whole leaf block and its band (a
+/// block's half diagonal, 3.5·√3 voxels, and the band's 3), so that the blocks wholly inside
+/// or outside the part are skipped, not sampled.
+pub const SPARE_VOXELS: f64 = 10.0;
+
 impl Grid {
     /// The grid's values at `points` (xyz triples, mm), interpolated trilinearly between voxel
     /// centres, into `values` (one per point).

@@ -102,6 +102,9 @@ pub struct Parsed {
     pub short_faces: u64,
     /// Faces with more than three corners, cut into triangles.
     pub polygons_split: u64,
+    /// Beam lattices (3MF Beam Lattice extension), not meshed: the part is `mesh` united with
+    /// their solids.
+    pub lattices: Vec<threemf::BeamLattice>,
 }
 
 /// How to read.
@@ -109,6 +112,30 @@ pub struct Parsed {
 pub struct ReadOptions {
     /// Also merge vertices closer than this, mm (0 = exact welding only).
     pub weld_tolerance: f64,
+    /// Voxel for meshing beam lattices, mm (automatic when `None`; see
+    /// [`crate::mesh::part::read`]).
+    pub beam_voxel: Option<f64>,
+}
+
+/// Beam lattices read as a solid: what was meshed, on what voxels.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct BeamsMeshed {
+    /// Lattices (placed objects holding one).
+    pub lattices: u64,
+    /// Beams meshed.
+    pub beams: u64,
+    /// Balls meshed.
+    pub balls: u64,
+    /// Beams shorter than their lattice's `minlength`, ignored as the extension says.
+    pub short_beams_ignored: u64,
+    /// The thinnest beam or ball radius, mm.
+    #[serde(rename = "thinnest_radius_mm")]
+    pub thinnest_radius: f64,
+    /// The voxel meshed on, mm.
+    #[serde(rename = "voxel_mm")]
+    pub voxel: f64,
+    /// Triangles of the lattices' solid.
+    pub triangles: u64,
 }
 
 /// A file read into a mesh, with what reading did to it.
@@ -126,6 +153,10 @@ pub struct Loaded {
     pub polygons_split: u64,
     /// Vertices merged by `weld_tolerance` (beyond exact welding).
     pub tolerance_welded: u64,
+    /// Beam lattices (3MF), not meshed: [`crate::mesh::part::read`] meshes them into `mesh`.
+    pub lattices: Vec<threemf::BeamLattice>,
+    /// The beam lattices meshed into `mesh`, when there were any.
+    pub beams: Option<BeamsMeshed>,
 }
 
 impl Loaded {
@@ -135,12 +166,13 @@ impl Loaded {
             faces_with_fewer_than_3_corners_skipped: self.short_faces,
             polygons_split_into_triangles: self.polygons_split,
             vertices_merged_by_tolerance: self.tolerance_welded,
+            beam_lattices: self.beams,
         }
     }
 }
 
 /// What reading a file did to it, as reports give it (all zero for a clean file).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct Reading {
     /// Faces with fewer than three corners, skipped.
     pub faces_with_fewer_than_3_corners_skipped: u64,
@@ -148,6 +180,9 @@ pub struct Reading {
     pub polygons_split_into_triangles: u64,
     /// Vertices merged by the weld tolerance (beyond exact welding).
     pub vertices_merged_by_tolerance: u64,
+    /// Beam lattices meshed into the part.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub beam_lattices: Option<BeamsMeshed>,
 }
 
 /// Parses `data` as `format`.
@@ -182,6 +217,8 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded> {
         short_faces: p.short_faces,
         polygons_split: p.polygons_split,
         tolerance_welded,
+        lattices: p.lattices,
+        beams: None,
     })
 }
 
@@ -294,14 +331,25 @@ impl PolygonSink {
     }
 
     pub fn finish(self) -> Result<Parsed> {
-        if self.indices.is_empty() {
+        self.finish_or_empty(false)
+    }
+
+    /// As [`PolygonSink::finish`], with no triangles allowed when `empty_ok` (the file holds
+    /// its geometry otherwise).
+    pub fn finish_or_empty(self, empty_ok: bool) -> Result<Parsed> {
+        if self.indices.is_empty() && !empty_ok {
             return Err(Error::parse("no triangles in the file"));
         }
         Ok(Parsed {
-            mesh: weld::weld_indexed(&self.positions, &self.indices)?,
+            mesh: if self.indices.is_empty() {
+                Mesh::default()
+            } else {
+                weld::weld_indexed(&self.positions, &self.indices)?
+            },
             normals: None,
             short_faces: self.short_faces,
             polygons_split: self.polygons_split,
+            lattices: Vec::new(),
         })
     }
 }

@@ -9,6 +9,7 @@
 
 use super::{Parsed, PolygonSink};
 use crate::error::{Error, Result};
+pub use crate::field::beams::Cap;
 use crate::mesh::Mesh;
 use quick_xml::events::{BytesStart, Event};
 use std::collections::HashMap;
@@ -54,8 +55,63 @@ struct Object {
     positions: Vec<f32>,
     triangles: Vec<u32>,
     components: Vec<(Key, Transform)>,
-    /// Beams of the Beam Lattice extension (not read as geometry).
-    beams: u64,
+    /// The object's beam lattice (Beam Lattice extension), in the object's coordinates.
+    lattice: Option<LatticeDef>,
+}
+
+/// A beam: a conical frustum between two vertices, a radius at each end, each end capped.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Beam {
+    /// Vertex indices of the two ends.
+    pub ends: [u32; 2],
+    /// Radius at each end, mm.
+    pub radii: [f64; 2],
+    /// How each end is closed.
+    pub caps: [Cap; 2],
+}
+
+/// Which side of the clipping mesh a lattice keeps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Clipping {
+    /// The lattice inside the clipping mesh.
+    Inside,
+    /// The lattice outside it.
+    Outside,
+}
+
+/// A beam lattice of the 3MF Beam Lattice extension (v1.2) as placed by the build, in mm:
+/// beams (frustums with capped ends) and balls (spheres) between vertices, clipped by a mesh,
+/// and the triangles of the object that holds it, which the solid unites with the lattice.
+#[derive(Debug, Clone, Default)]
+pub struct BeamLattice {
+    /// Vertex positions, mm.
+    pub vertices: Vec<[f64; 3]>,
+    /// The beams no shorter than the lattice's `minlength`.
+    pub beams: Vec<Beam>,
+    /// Balls: vertex index and radius, mm.
+    pub balls: Vec<(u32, f64)>,
+    /// The clipping mesh and the side kept.
+    pub clip: Option<(Clipping, Mesh)>,
+    /// The triangles of the object that holds the lattice (often none).
+    pub mesh: Mesh,
+    /// Beams dropped as shorter than `minlength`.
+    pub short_beams: u64,
+}
+
+/// A `<beamlattice>` as read, in the object's coordinates (mm).
+#[derive(Default)]
+struct LatticeDef {
+    radius: f64,
+    min_length: f64,
+    cap: Cap,
+    /// `ballmode`: 0 none, 1 mixed, 2 all.
+    ball_mode: u8,
+    ball_radius: Option<f64>,
+    clip: Option<(Clipping, u64)>,
+    beams: Vec<Beam>,
+    /// Balls given: vertex and radius (`None`: the lattice's `ballradius`).
+    balls: Vec<(u32, Option<f64>)>,
+    short_beams: u64,
 }
 
 /// Most model parts a package may reference (Production extension).
@@ -160,6 +216,7 @@ pub fn parse(data: &[u8]) -> Result<Parsed> {
     let mut objects: HashMap<Key, Object> = HashMap::new();
     let mut items: Vec<(Key, Transform)> = Vec::new();
     let mut stored_triangles = 0u64;
+    let mut stored_beams = 0u64;
     let mut todo = vec![root.clone()];
     let mut seen: std::collections::HashSet<String> = todo.iter().cloned().collect();
     let mut bytes = 0u64;
@@ -175,6 +232,7 @@ pub fn parse(data: &[u8]) -> Result<Parsed> {
             (part == root).then_some(&mut items),
             &mut objects,
             &mut stored_triangles,
+            &mut stored_beams,
         )?;
         for p in named {
             if seen.len() >= MAX_PARTS {
@@ -211,7 +269,11 @@ pub fn parse(data: &[u8]) -> Result<Parsed> {
                 key.1, key.0
             ))
         })?;
-        let mut n = ((o.triangles.len() / 3) as u64, o.beams, 1u64);
+        let beams = o
+            .lattice
+            .as_ref()
+            .map_or(0, |l| (l.beams.len() + l.balls.len()) as u64);
+        let mut n = ((o.triangles.len() / 3) as u64, beams, 1u64);
         for (c, _) in &o.components {
             let (cn, cb, ci) = count(objects, c, depth + 1, memo)?;
             n = (
@@ -231,9 +293,10 @@ pub fn parse(data: &[u8]) -> Result<Parsed> {
         beams = beams.saturating_add(b);
         instances = instances.saturating_add(i);
     }
-    if beams > 0 {
+    let beam_cap = 10_000_000 + 16 * stored_beams;
+    if beams > beam_cap {
         return Err(Error::parse(format!(
-            "{beams} beams of the 3MF Beam Lattice extension: beam lattices are not read as solids yet (export the lattice as a mesh)"
+            "build expands {stored_beams} stored beams and balls to {beams}, over the limit of {beam_cap}"
         )));
     }
     let placed = 1_000_000 + 16 * objects.len() as u64;
@@ -254,8 +317,16 @@ pub fn parse(data: &[u8]) -> Result<Parsed> {
         key: &Key,
         m: &Transform,
         sink: &mut PolygonSink,
+        lattices: &mut Vec<BeamLattice>,
     ) -> Result<()> {
         let o = &objects[key];
+        if let Some(l) = &o.lattice {
+            lattices.push(place_lattice(objects, key, l, m)?);
+            for (c, t) in &o.components {
+                emit(objects, c, &compose(t, m), sink, lattices)?;
+            }
+            return Ok(());
+        }
         let base = sink.vertex_count() as u32;
         for p in o.positions.chunks_exact(3) {
             sink.push_vertex(apply(m, [p[0], p[1], p[2]]))?;
@@ -267,15 +338,210 @@ pub fn parse(data: &[u8]) -> Result<Parsed> {
             sink.end_face()?;
         }
         for (c, t) in &o.components {
-            emit(objects, c, &compose(t, m), sink)?;
+            emit(objects, c, &compose(t, m), sink, lattices)?;
         }
         Ok(())
     }
     let mut sink = PolygonSink::new();
+    let mut lattices = Vec::new();
     for (key, t) in &items {
-        emit(&objects, key, t, &mut sink)?;
+        emit(&objects, key, t, &mut sink, &mut lattices)?;
     }
-    sink.finish()
+    let mut parsed = sink.finish_or_empty(!lattices.is_empty())?;
+    parsed.lattices = lattices;
+    Ok(parsed)
+}
+
+/// The triangles of object `key` placed by `m` (mm).
+fn placed_mesh(o: &Object, m: &Transform) -> Result<Mesh> {
+    let positions: Vec<f32> = o
+        .positions
+        .chunks_exact(3)
+        .flat_map(|p| apply(m, [p[0], p[1], p[2]]))
+        .collect();
+    if o.triangles.is_empty() {
+        return Ok(Mesh::default());
+    }
+    super::weld::weld_indexed(&positions, &o.triangles)
+}
+
+/// The lattice `l` of object `key` placed by `m`: vertices moved, radii scaled. A beam stays a
+/// frustum only under a similarity (rotation, mirror, uniform scale, translation): any other
+/// transform of a lattice is refused.
+fn place_lattice(
+    objects: &HashMap<Key, Object>,
+    key: &Key,
+    l: &LatticeDef,
+    m: &Transform,
+) -> Result<BeamLattice> {
+    // Rows of the linear part: a similarity's are orthogonal and of one length.
+    let row = |r: usize| [m[3 * r], m[3 * r + 1], m[3 * r + 2]];
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let s2 = (0..3).map(|r| dot(row(r), row(r))).sum::<f64>() / 3.0;
+    let similar = s2 > 0.0
+        && (0..3).all(|r| {
+            (0..3).all(|c| {
+                let want = if r == c { s2 } else { 0.0 };
+                (dot(row(r), row(c)) - want).abs() <= 1e-6 * s2
+            })
+        });
+    if !similar {
+        return Err(Error::parse(format!(
+            "object {} holds a beam lattice placed by a transform that shears or scales unevenly (its beams would not stay round): not supported",
+            key.1
+        )));
+    }
+    let s = s2.sqrt();
+    let o = &objects[key];
+    let vertices: Vec<[f64; 3]> = o
+        .positions
+        .chunks_exact(3)
+        .map(|p| {
+            let [x, y, z] = [p[0], p[1], p[2]].map(|v| v as f64);
+            [0, 1, 2].map(|c| x * m[c] + y * m[3 + c] + z * m[6 + c] + m[9 + c])
+        })
+        .collect();
+    let beams = l
+        .beams
+        .iter()
+        .map(|b| Beam {
+            radii: b.radii.map(|r| r * s),
+            ..*b
+        })
+        .collect();
+    let ball = |r: Option<f64>| -> Result<f64> {
+        r.or(l.ball_radius).map(|r| r * s).ok_or_else(|| {
+            Error::parse(format!(
+                "object {}: a ball without a radius in a lattice without ballradius",
+                key.1
+            ))
+        })
+    };
+    let mut balls = Vec::new();
+    match l.ball_mode {
+        1 => {
+            for &(v, r) in &l.balls {
+                balls.push((v, ball(r)?));
+            }
+        }
+        2 => {
+            let given: HashMap<u32, Option<f64>> = l.balls.iter().copied().collect();
+            let mut ends: Vec<u32> = l.beams.iter().flat_map(|b| b.ends).collect();
+            ends.sort_unstable();
+            ends.dedup();
+            for v in ends {
+                balls.push((v, ball(given.get(&v).copied().flatten())?));
+            }
+        }
+        _ => {}
+    }
+    let clip = match l.clip {
+        None => None,
+        Some((side, id)) => {
+            let k = (key.0.clone(), id);
+            let c = objects.get(&k).ok_or_else(|| {
+                Error::parse(format!(
+                    "object {}: clipping mesh {id} is not defined in /{}",
+                    key.1, key.0
+                ))
+            })?;
+            if c.lattice.is_some() || c.triangles.is_empty() || k == *key {
+                return Err(Error::parse(format!(
+                    "object {}: clipping mesh {id} must be another object of triangles without a lattice",
+                    key.1
+                )));
+            }
+            Some((side, placed_mesh(c, m)?))
+        }
+    };
+    Ok(BeamLattice {
+        vertices,
+        beams,
+        balls,
+        clip,
+        mesh: placed_mesh(o, m)?,
+        short_beams: l.short_beams,
+    })
+}
+
+/// A positive finite length attribute, converted to mm.
+fn length(e: &BytesStart, name: &str, scale: f64) -> Result<f64> {
+    let v: f64 = num(e, name)?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(Error::parse(format!(
+            "{name} must be a positive length, not {v}"
+        )));
+    }
+    Ok(v * scale)
+}
+
+/// A cap mode attribute, `default` when absent.
+fn cap(e: &BytesStart, name: &str, default: Cap) -> Result<Cap> {
+    Ok(match attr(e, name)?.as_deref().map(str::trim) {
+        None => default,
+        Some("sphere") => Cap::Sphere,
+        Some("hemisphere") => Cap::Hemisphere,
+        Some("butt") => Cap::Butt,
+        Some(c) => {
+            return Err(Error::parse(format!(
+                "unknown {name} '{}'",
+                c.chars().take(24).collect::<String>()
+            )))
+        }
+    })
+}
+
+/// A `<beamlattice>` element's settings.
+fn lattice_def(e: &BytesStart, scale: f64) -> Result<LatticeDef> {
+    let ball_mode = match attr(e, "ballmode")?.as_deref().map(str::trim) {
+        None | Some("none") => 0,
+        Some("mixed") => 1,
+        Some("all") => 2,
+        Some(m) => {
+            return Err(Error::parse(format!(
+                "unknown ballmode '{}'",
+                m.chars().take(24).collect::<String>()
+            )))
+        }
+    };
+    let ball_radius = match attr(e, "ballradius")? {
+        Some(_) => Some(length(e, "ballradius", scale)?),
+        None => None,
+    };
+    let clip = match attr(e, "clippingmode")?.as_deref().map(str::trim) {
+        None | Some("none") => None,
+        Some(m @ ("inside" | "outside")) => {
+            let side = if m == "inside" {
+                Clipping::Inside
+            } else {
+                Clipping::Outside
+            };
+            Some((side, num(e, "clippingmesh")?))
+        }
+        Some(m) => {
+            return Err(Error::parse(format!(
+                "unknown clippingmode '{}'",
+                m.chars().take(24).collect::<String>()
+            )))
+        }
+    };
+    let min_length: f64 = match attr(e, "minlength")? {
+        Some(_) => num(e, "minlength")?,
+        None => 0.0,
+    };
+    Ok(LatticeDef {
+        radius: length(e, "radius", scale)?,
+        min_length: if min_length.is_finite() {
+            min_length.max(0.0) * scale
+        } else {
+            0.0
+        },
+        cap: cap(e, "cap", Cap::Sphere)?,
+        ball_mode,
+        ball_radius,
+        clip,
+        ..LatticeDef::default()
+    })
 }
 
 /// The object being read, for an `element` that belongs inside one.
@@ -298,6 +564,7 @@ fn parse_part(
     mut items: Option<&mut Vec<(Key, Transform)>>,
     objects: &mut HashMap<Key, Object>,
     stored_triangles: &mut u64,
+    stored_beams: &mut u64,
 ) -> Result<Vec<String>> {
     let text = std::str::from_utf8(xml)
         .map_err(|_| Error::parse(format!("model part /{part} is not UTF-8")))?;
@@ -385,7 +652,74 @@ fn parse_part(
                 o.triangles.extend_from_slice(&t);
                 *stored_triangles += 1;
             }
-            "beam" => open(objects, &current, "beam")?.beams += 1,
+            "beamlattice" => {
+                let o = open(objects, &current, "beamlattice")?;
+                if o.lattice.is_some() {
+                    return Err(Error::parse("two <beamlattice>s in one object"));
+                }
+                o.lattice = Some(lattice_def(&e, scale)?);
+            }
+            "beam" => {
+                let o = open(objects, &current, "beam")?;
+                let nv = o.positions.len() / 3;
+                let l = o
+                    .lattice
+                    .as_mut()
+                    .ok_or_else(|| Error::parse("<beam> outside a <beamlattice>"))?;
+                let ends: [u32; 2] = [num(&e, "v1")?, num(&e, "v2")?];
+                if ends.iter().any(|&i| i as usize >= nv) {
+                    return Err(Error::parse(format!(
+                        "beam {ends:?} names a vertex past the {nv} vertices"
+                    )));
+                }
+                let r1 = match attr(&e, "r1")? {
+                    Some(_) => length(&e, "r1", scale)?,
+                    None => l.radius,
+                };
+                let r2 = match attr(&e, "r2")? {
+                    Some(_) => length(&e, "r2", scale)?,
+                    None => r1,
+                };
+                let caps = [cap(&e, "cap1", l.cap)?, cap(&e, "cap2", l.cap)?];
+                let p = |i: u32| {
+                    let i = 3 * i as usize;
+                    [0, 1, 2].map(|a| o.positions[i + a] as f64)
+                };
+                let (a, b) = (p(ends[0]), p(ends[1]));
+                let len = (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt();
+                // The extension's consumers ignore beams shorter than minlength (and a beam
+                // from a vertex to itself).
+                if ends[0] == ends[1] || len < l.min_length {
+                    l.short_beams += 1;
+                } else {
+                    l.beams.push(Beam {
+                        ends,
+                        radii: [r1, r2],
+                        caps,
+                    });
+                }
+                *stored_beams += 1;
+            }
+            "ball" => {
+                let o = open(objects, &current, "ball")?;
+                let nv = o.positions.len() / 3;
+                let l = o
+                    .lattice
+                    .as_mut()
+                    .ok_or_else(|| Error::parse("<ball> outside a <beamlattice>"))?;
+                let v: u32 = num(&e, "vindex")?;
+                if v as usize >= nv {
+                    return Err(Error::parse(format!(
+                        "ball at vertex {v} past the {nv} vertices"
+                    )));
+                }
+                let r = match attr(&e, "r")? {
+                    Some(_) => Some(length(&e, "r", scale)?),
+                    None => None,
+                };
+                l.balls.push((v, r));
+                *stored_beams += 1;
+            }
             "component" => {
                 let key = target(&e, &mut named)?;
                 let t = transform(&e, scale)?;

@@ -16,6 +16,7 @@ pub mod graded;
 mod indexed;
 pub mod instance;
 pub mod output;
+pub mod part;
 pub mod pieces;
 pub mod pipeline;
 pub mod report;

@@ -57,7 +57,7 @@ pub fn remesh(mesh: &Mesh, voxel: f64) -> Result<(Mesh, u64)> {
             None,
             &CheckOptions {
                 self_intersections: false,
-                tolerance: 0.0,
+                ..CheckOptions::default()
             },
         )?;
         let valid = found.defects().is_empty() || out.triangle_count() == 0;
