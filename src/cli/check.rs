@@ -15,8 +15,12 @@ Examples:
   latvox check scan.ply --weld-tolerance 0.001
   latvox check part.3mf --json > part-check.json
   latvox check big.stl --no-self-intersection --report big-check.json
+  latvox check implant.3mf --beam-voxel 0.02
 
-Reads STL (binary or ASCII), OBJ, OFF, PLY (ASCII or binary) and 3MF. Counts facets, vertices,
+Reads STL (binary or ASCII), OBJ, OFF, PLY (ASCII or binary) and 3MF — with the Production
+extension's model parts, and the Beam Lattice extension's beams and balls made a solid (each
+beam a frustum capped as the file says, clipped by its clipping mesh, united with its object's
+triangles; meshed on voxels of a sixth of the thinnest radius, or --beam-voxel). Counts facets, vertices,
 edges and shells (each with volume, area, Euler characteristic and genus); boundary edges and
 hole loops; non-manifold edges and vertices; stored normals that disagree with the winding;
 inconsistently wound neighbours; inward-facing shells; degenerate and duplicate facets;
@@ -113,6 +117,25 @@ pub(crate) fn print_header(file: &str, format: Format, facets: u64, r: &Reading)
     }
     if !notes.is_empty() {
         outln!("reading   {}", notes.join(", "));
+    }
+    if let Some(b) = &r.beam_lattices {
+        outln!(
+            "beams     {} beams and {} balls in {} lattice{} meshed as a solid on voxels of {:.4} mm (thinnest radius {:.4} mm){}",
+            b.beams,
+            b.balls,
+            b.lattices,
+            if b.lattices == 1 { "" } else { "s" },
+            b.voxel,
+            b.thinnest_radius,
+            if b.short_beams_ignored > 0 {
+                format!(
+                    "; {} beams shorter than minlength ignored",
+                    b.short_beams_ignored
+                )
+            } else {
+                String::new()
+            }
+        );
     }
 }
 

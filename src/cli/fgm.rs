@@ -284,7 +284,7 @@ impl FgmArgs {
                 (geometry, p.display().to_string(), (lo, hi))
             }
             (None, Some(m)) => {
-                let mesh = latvox::io::read(m, &ReadOptions::default())?.mesh;
+                let mesh = latvox::mesh::part::read(m, &ReadOptions::default())?.mesh;
                 let b = mesh
                     .bounds()
                     .ok_or_else(|| Error::invalid(format!("{}: no triangles", m.display())))?;

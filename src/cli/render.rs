@@ -190,7 +190,7 @@ pub fn run(a: &RenderArgs) -> Result<i32> {
         };
         (frames, "implicit")
     } else {
-        let loaded = latvox::io::read(&a.input, &Default::default())?;
+        let loaded = latvox::mesh::part::read(&a.input, &Default::default())?;
         if loaded.mesh.indices.is_empty() {
             return Err(Error::invalid(format!(
                 "{}: no triangles to render",

@@ -80,7 +80,7 @@ impl Feature {
             }
             "surface" => {
                 let path = Path::new(arg);
-                let mesh = crate::io::read(path, &crate::io::ReadOptions::default())?.mesh;
+                let mesh = crate::mesh::part::read(path, &crate::io::ReadOptions::default())?.mesh;
                 if mesh.triangle_count() == 0 {
                     return Err(Error::invalid(format!("{}: no triangles", path.display())));
                 }
