@@ -20,10 +20,10 @@ Examples:
 Reads STL (binary or ASCII), OBJ, OFF, PLY (ASCII or binary) and 3MF — with the Production
 extension's model parts, and the Beam Lattice extension's beams and balls made a solid (each
 beam a frustum capped as the file says, clipped by its clipping mesh, united with its object's
-triangles; meshed on voxels of a sixth of the thinnest radius, or --beam-voxel). Counts facets, vertices,
-edges and shells (each with volume, area, Euler characteristic and genus); boundary edges and
-hole loops; non-manifold edges and vertices; stored normals that disagree with the winding;
-inconsistently wound neighbours; inward-facing shells; degenerate and duplicate facets;
+triangles; meshed on voxels of a sixth of the thinnest radius, or --beam-voxel). Counts facets,
+vertices, edges and shells (each with volume, area, Euler characteristic and genus); boundary
+edges and hole loops; non-manifold edges and vertices; stored normals that disagree with the
+winding; inconsistently wound neighbours; inward-facing shells; degenerate and duplicate facets;
 T-junctions; and self-intersecting facet pairs (exact, with CGAL's triangle tests). CGAL checks
 closedness, orientation and volume beside latvox, as a second opinion.
 
@@ -54,8 +54,8 @@ pub struct CheckFlags {
     #[arg(long)]
     pub no_self_intersection: bool,
     /// Voxel (mm) on which the beam lattices of a 3MF file are meshed into solids [default: a
-    /// sixth of the thinnest beam's radius, coarser only if the part would pass 2·10⁷ active
-    /// voxels].
+    /// sixth of the thinnest beam's radius, coarser where the part would pass 2·10⁷ active
+    /// voxels, down to four voxels across the thinnest beam].
     #[arg(long, value_name = "MM", value_parser = super::parse_positive)]
     pub beam_voxel: Option<f64>,
 }

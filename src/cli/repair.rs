@@ -18,6 +18,7 @@ Examples:
   latvox repair broken.ply -o solid.stl --remesh auto
   latvox repair broken.ply -o solid.stl --remesh 0.2
   latvox repair assembly.stl -o part.stl --drop-open-shells
+  latvox repair implant-lattice.3mf -o implant.stl --beam-voxel 0.02
 
 Removes degenerate and duplicate facets; stitches borders that match; splits edges at
 T-junctions; separates shells that touch at a vertex or along an edge; makes winding
@@ -35,10 +36,13 @@ remeshed. The result is one valid closed solid, or the reason none exists.
 
 --remesh VOXEL|auto rebuilds the part through an OpenVDB level set: closed, manifold and free
 of self-intersections at that resolution (details below a voxel are lost). auto: a quarter of
-the thinnest shell's mean thickness (2·volume/area), at most 1/64 of the part, within a memory
-bound. With --solid, it sets the voxel of the remeshes the solid needs. When geometry moved,
+the part's smallest feature (the shortest ray from a facet, along or against its normal, to
+another facet of its shell: a plate's thickness, a rod's diameter, a slot's gap), at most 1/64
+of the part, within a memory bound. With --solid, it sets the voxel of the remeshes the solid needs. When geometry moved,
 the deviation from the input is measured both ways (every vertex to the other mesh, CGAL).
 
+A 3MF file's beam lattices (Beam Lattice extension) are read as the solid they describe, meshed
+as `latvox check --help` says (--beam-voxel sets the voxel): the output is that solid's mesh.
 The output format follows the extension of -o (.stl .obj .off .ply .3mf).
 Self-intersections are counted on the result only (--solid and --remesh mend them).
 Exit codes: 0 the result written is a valid closed solid; 1 it is written but defects remain

@@ -143,6 +143,22 @@ pub struct BeamField {
     /// Per bin, the range of `items` listing its pieces (CSR).
     start: Vec<u32>,
     items: Vec<u32>,
+    /// Per bin, rings of bins (26-neighbourhood) to the nearest bin that lists a piece: a point
+    /// in a bin `k` rings away is more than `reach + (k − 1)·edge` from every piece.
+    rings: Vec<u16>,
+}
+
+/// Distance from `p` to the segment `ab`.
+fn segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f64 {
+    let ab = sub(b, a);
+    let ap = sub(p, a);
+    let l2 = dot(ab, ab);
+    let t = if l2 > 0.0 {
+        (dot(ap, ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    norm(sub(ap, ab.map(|x| x * t)))
 }
 
 impl BeamField {
@@ -175,57 +191,90 @@ impl BeamField {
         );
         let grown = bounds.grown(reach);
         let size = grown.size();
-        // About two bins per piece, and no bin smaller than the reach (a piece then lists in
-        // a few bins along its length, not many).
-        let want = (2 * pieces.len()).clamp(1, MAX_BINS) as f64;
-        let edge = (size[0] * size[1] * size[2] / want)
+        // Bins as small as the reach (a lookup then sees the pieces near the point, a few),
+        // no more of them than MAX_BINS.
+        let edge = (size[0] * size[1] * size[2] / MAX_BINS as f64)
             .cbrt()
             .max(reach)
             .max(1e-9);
-        let dims = size.map(|s| ((s / edge).ceil() as usize).max(1));
-        let edge = (0..3)
-            .map(|k| size[k] / dims[k] as f64)
-            .fold(0.0f64, f64::max)
-            .max(1e-9);
+        let dims = size.map(|s| ((s / edge).ceil() as usize).clamp(1, MAX_BINS));
         let cells = dims[0] * dims[1] * dims[2];
-        let range = |b: &Aabb| {
-            let g = b.grown(reach);
+        let half_diagonal = 0.5 * 3f64.sqrt() * edge;
+        let bin = |c: [usize; 3]| (c[0] * dims[1] + c[1]) * dims[2] + c[2];
+        // A piece is listed in the bins whose centre lies within its radius, the reach and
+        // the bin's half diagonal of its axis.
+        let listed = |n: usize, f: &mut dyn FnMut(usize)| {
+            let g = boxes[n].grown(reach);
             let lo = [0, 1, 2].map(|k| {
                 (((g.min[k] - grown.min[k]) / edge).floor().max(0.0) as usize).min(dims[k] - 1)
             });
             let hi = [0, 1, 2].map(|k| {
                 (((g.max[k] - grown.min[k]) / edge).floor().max(0.0) as usize).min(dims[k] - 1)
             });
-            (lo, hi)
-        };
-        let bin = |i: usize, j: usize, k: usize| (i * dims[1] + j) * dims[2] + k;
-        let mut count = vec![0u32; cells + 1];
-        for b in &boxes {
-            let (lo, hi) = range(b);
+            let (a, b, r) = match pieces[n] {
+                Piece::Beam { a, b, ra, rb, .. } => (a, b, ra.max(rb)),
+                Piece::Ball { c, r } => (c, c, r),
+            };
             for i in lo[0]..=hi[0] {
                 for j in lo[1]..=hi[1] {
                     for k in lo[2]..=hi[2] {
-                        count[bin(i, j, k) + 1] += 1;
+                        let c = [i, j, k];
+                        let centre = [0, 1, 2].map(|x| grown.min[x] + (c[x] as f64 + 0.5) * edge);
+                        if segment_distance(centre, a, b) <= r + reach + half_diagonal {
+                            f(bin(c));
+                        }
                     }
                 }
             }
+        };
+        let mut count = vec![0u32; cells + 1];
+        for n in 0..pieces.len() {
+            listed(n, &mut |c| count[c + 1] += 1);
         }
         for c in 1..=cells {
             count[c] += count[c - 1];
         }
         let mut fill = count.clone();
         let mut items = vec![0u32; count[cells] as usize];
-        for (n, b) in boxes.iter().enumerate() {
-            let (lo, hi) = range(b);
-            for i in lo[0]..=hi[0] {
-                for j in lo[1]..=hi[1] {
-                    for k in lo[2]..=hi[2] {
-                        let c = bin(i, j, k);
-                        items[fill[c] as usize] = n as u32;
-                        fill[c] += 1;
+        for n in 0..pieces.len() {
+            listed(n, &mut |c| {
+                items[fill[c] as usize] = n as u32;
+                fill[c] += 1;
+            });
+        }
+        // Rings to the nearest listing bin: breadth first from all of them at once.
+        let mut rings = vec![u16::MAX; cells];
+        let mut front: Vec<usize> = (0..cells).filter(|&c| count[c + 1] > count[c]).collect();
+        for &c in &front {
+            rings[c] = 0;
+        }
+        let mut ring = 0u16;
+        while !front.is_empty() && ring < u16::MAX - 1 {
+            ring += 1;
+            let mut next = Vec::new();
+            for c in front {
+                let (i, j, k) = (
+                    c / (dims[1] * dims[2]),
+                    (c / dims[2]) % dims[1],
+                    c % dims[2],
+                );
+                for di in -1i64..=1 {
+                    for dj in -1i64..=1 {
+                        for dk in -1i64..=1 {
+                            let n = [i as i64 + di, j as i64 + dj, k as i64 + dk];
+                            if (0..3).any(|x| n[x] < 0 || n[x] >= dims[x] as i64) {
+                                continue;
+                            }
+                            let nb = bin(n.map(|x| x as usize));
+                            if rings[nb] == u16::MAX {
+                                rings[nb] = ring;
+                                next.push(nb);
+                            }
+                        }
                     }
                 }
             }
+            front = next;
         }
         BeamField {
             pieces,
@@ -236,6 +285,7 @@ impl BeamField {
             dims,
             start: count,
             items,
+            rings,
         }
     }
 
@@ -249,8 +299,8 @@ impl BeamField {
         self.pieces.is_empty()
     }
 
-    /// The pieces listed in the bin holding `p`, or `None` outside the bins.
-    fn near(&self, p: Vec3) -> Option<&[u32]> {
+    /// The bin holding `p`, or `None` outside the bins.
+    fn bin_of(&self, p: Vec3) -> Option<usize> {
         let mut c = [0usize; 3];
         for k in 0..3 {
             let x = (p[k] - self.origin[k]) / self.edge;
@@ -259,27 +309,59 @@ impl BeamField {
             }
             c[k] = x as usize;
         }
-        let b = (c[0] * self.dims[1] + c[1]) * self.dims[2] + c[2];
-        Some(&self.items[self.start[b] as usize..self.start[b + 1] as usize])
+        Some((c[0] * self.dims[1] + c[1]) * self.dims[2] + c[2])
+    }
+
+    fn listed(&self, b: usize) -> &[u32] {
+        &self.items[self.start[b] as usize..self.start[b + 1] as usize]
+    }
+
+    /// The value at `p` and the piece that gives it (`None` beyond the reach).
+    fn nearest(&self, p: Vec3) -> (f64, Option<u32>) {
+        let Some(b) = self.bin_of(p) else {
+            return (self.reach, None);
+        };
+        let mut best = (self.reach, None);
+        for &i in self.listed(b) {
+            let d = self.pieces[i as usize].distance(p);
+            if d < best.0 {
+                best = (d, Some(i));
+            }
+        }
+        best
     }
 }
 
 impl Field for BeamField {
     fn value(&self, p: Vec3) -> f64 {
-        let Some(near) = self.near(p) else {
-            return self.reach;
-        };
-        near.iter()
-            .map(|&i| self.pieces[i as usize].distance(p))
-            .fold(self.reach, f64::min)
+        self.nearest(p).0
     }
 
     fn clearance(&self, p: Vec3) -> f64 {
-        if self.near(p).is_none() {
+        match self.bin_of(p) {
             // Outside the bins: at least the reach from every piece, and beyond their bounds.
-            return self.reach.max(self.bounds.value(p));
+            None => self.reach.max(self.bounds.value(p)),
+            Some(b) if self.start[b] == self.start[b + 1] => {
+                let k = self.rings[b];
+                if k == u16::MAX {
+                    f64::INFINITY
+                } else {
+                    self.reach + (k as f64 - 1.0).max(0.0) * self.edge
+                }
+            }
+            Some(_) => self.value(p).abs(),
         }
-        self.value(p).abs()
+    }
+
+    /// The nearest piece's value and gradient (by central differences of that piece alone).
+    fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
+        match self.nearest(p) {
+            (v, Some(i)) => {
+                let piece = &self.pieces[i as usize];
+                (v, super::numeric_gradient(|q| piece.distance(q), p))
+            }
+            (v, None) => (v, super::numeric_gradient(|q| self.value(q), p)),
+        }
     }
 }
 
@@ -367,6 +449,7 @@ mod tests {
         let reach = 1.0;
         let f = BeamField::new(&beams, &balls, reach);
         assert_eq!(f.pieces.len(), 302);
+        assert!(f.rings.iter().any(|&k| k > 1));
         for _ in 0..20000 {
             let p = [0, 1, 2].map(|_| rnd() * 30.0 - 5.0);
             let exact = f

@@ -69,7 +69,8 @@ fn thinnest(lattices: &[BeamLattice]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// The area of the lattices' beams, balls and meshes, mm² (an upper bound on the surface's).
+/// The area of the lattices' beams' sides, balls and meshes, mm² (about the surface's: the
+/// caps mostly lie inside joints, and joints overlap).
 fn area(lattices: &[BeamLattice]) -> f64 {
     use std::f64::consts::PI;
     lattices
@@ -84,7 +85,7 @@ fn area(lattices: &[BeamLattice]) -> f64 {
                     let len = (0..3).map(|k| (a[k] - c[k]).powi(2)).sum::<f64>().sqrt();
                     let [r1, r2] = b.radii;
                     let slant = (len * len + (r1 - r2).powi(2)).sqrt();
-                    PI * (r1 + r2) * slant + 4.0 * PI * (r1 * r1 + r2 * r2)
+                    PI * (r1 + r2) * slant
                 })
                 .sum();
             let balls: f64 = l.balls.iter().map(|b| 4.0 * PI * b.1 * b.1).sum();
@@ -94,7 +95,9 @@ fn area(lattices: &[BeamLattice]) -> f64 {
 }
 
 /// The voxel for `lattices`: `given`, or a sixth of the thinnest radius, coarsened so that
-/// the narrow band (six voxels across the surface) holds at most [`MAX_ACTIVE_VOXELS`].
+/// the narrow band (six voxels across the surface) holds at most [`MAX_ACTIVE_VOXELS`] — but
+/// never beyond half the thinnest radius (four voxels across the thinnest beam), below which
+/// beams would break apart: such a part takes the memory it needs.
 pub fn lattice_voxel(lattices: &[BeamLattice], given: Option<f64>) -> Result<(f64, f64)> {
     let r = thinnest(lattices);
     if let Some(v) = given {
@@ -115,7 +118,7 @@ pub fn lattice_voxel(lattices: &[BeamLattice], given: Option<f64>) -> Result<(f6
         return Ok((e / 200.0, r));
     }
     let bound = (2.0 * HALF_WIDTH * area(lattices) / MAX_ACTIVE_VOXELS).sqrt();
-    Ok(((r / VOXELS_PER_RADIUS).max(bound), r))
+    Ok(((r / VOXELS_PER_RADIUS).max(bound).min(r / 2.0), r))
 }
 
 fn union_box(a: &Aabb, b: &Aabb) -> Aabb {
@@ -218,7 +221,8 @@ struct LatticeSolid {
 impl LatticeSolid {
     fn new(lattices: &[BeamLattice], voxel: f64) -> Result<LatticeSolid> {
         let spare = HALF_WIDTH + SPARE_VOXELS;
-        let reach = spare * voxel;
+        // The beams' field is exact across the band and a voxel beyond it.
+        let reach = (HALF_WIDTH + 1.0) * voxel;
         let mut prepared = Vec::with_capacity(lattices.len());
         let mut bounds: Option<Aabb> = None;
         // Whether every lattice is clipped inside a box: the boxes' union bounds the solid
@@ -343,6 +347,20 @@ impl Field for LatticeField<'_> {
     /// comes near (but the solid's own box, whose planes the mesher snaps onto): a grid's
     /// surface (a clipping mesh, the object's triangles) is known only as well as OpenVDB's
     /// vertices already lie on it, and where a box cuts a beam two surfaces meet at an edge.
+    /// The value and its gradient: where the beams of one lattice give the value, the
+    /// gradient of their nearest piece (cheap); elsewhere (a clip or a mesh gives it) by
+    /// central differences of the whole.
+    fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
+        let v = self.value(p);
+        for l in &self.solid.lattices {
+            let (b, g) = l.beams.implicit_with_gradient(p);
+            if b == v {
+                return (v, g);
+            }
+        }
+        (v, crate::field::numeric_gradient(|q| self.value(q), p))
+    }
+
     fn smooth_near(&self, p: Vec3, reach: f64) -> bool {
         let far = reach + self.solid.voxel;
         self.solid.lattices.iter().all(|l| {
