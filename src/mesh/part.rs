@@ -41,8 +41,7 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded> {
         return Ok(loaded);
     }
     let lattices = std::mem::take(&mut loaded.lattices);
-    let (mesh, meshed) = mesh_lattices(&lattices, opts.beam_voxel)
-        .map_err(|e| Error::parse(format!("beam lattice: {e}")).in_file(path))?;
+    let (mesh, meshed) = mesh_lattices(&lattices, opts.beam_voxel).map_err(|e| e.in_file(path))?;
     loaded.mesh = join(std::mem::take(&mut loaded.mesh), &mesh);
     loaded.beams = Some(meshed);
     Ok(loaded)
@@ -148,7 +147,7 @@ pub fn mesh_lattices(lattices: &[BeamLattice], voxel: Option<f64>) -> Result<(Me
     };
     if mesh.triangle_count() == 0 {
         return Err(Error::parse(format!(
-            "the lattice leaves no solid on voxels of {voxel} mm (clipped away, or thinner than the voxels)"
+            "3MF: the beam lattice leaves no solid on voxels of {voxel} mm (clipped away, or thinner than the voxels)"
         )));
     }
     let triangles = mesh.triangle_count() as u64;
@@ -244,7 +243,9 @@ impl LatticeSolid {
                 .map(|&(v, r)| (l.vertices[v as usize], r))
                 .collect();
             let field = BeamField::new(&beams, &balls, reach);
-            let mut b = (!field.is_empty()).then(|| field.bounds());
+            // Two voxels clear of the beams: a box's faces clip the solid only where the
+            // clipping box cuts it, never where a beam just touches its bounds.
+            let mut b = (!field.is_empty()).then(|| field.bounds().grown(2.0 * voxel));
             let clip = match &l.clip {
                 None => None,
                 Some((side, m)) => {
