@@ -7,6 +7,7 @@ use crate::check::{check, read_file, CheckOptions, CheckReport, Defects, Verdict
 use crate::error::{Error, Result};
 use crate::io::{Format, ReadOptions, Reading};
 use crate::mesh::output::MeshFile;
+use crate::mesh::Mesh;
 use crate::progress::Progress;
 use std::path::Path;
 
@@ -42,6 +43,15 @@ pub struct FileRepairReport {
         serialize_with = "crate::check::verdict::valid_solid"
     )]
     pub verdict: Verdict,
+}
+
+/// Whether `a` and `b` hold the same facets, corner by corner, at the same positions.
+fn same_facets(a: &Mesh, b: &Mesh) -> bool {
+    a.triangle_count() == b.triangle_count()
+        && a.indices
+            .iter()
+            .zip(&b.indices)
+            .all(|(&i, &j)| a.vertex(i) == b.vertex(j))
 }
 
 /// Reads `input`, checks it, repairs it, writes the result to `output` atomically and checks the
@@ -82,11 +92,25 @@ pub fn repair_file(
         output.save(&mesh)?;
     }
     // The verdict is on the file as written and read back, as the next program will see it
-    // (STL, for one, welds vertices by position).
+    // (STL, for one, welds vertices by position). A solid already searched for crossing facets
+    // is not searched again when the file holds the same facets: welding only shares corners,
+    // which can take intersections away, never add one.
     let after = {
         let _s = progress.stage("checking the written file");
         let written = crate::io::read(&output.path, &ReadOptions::default())?;
-        check(&written.mesh, written.normals.as_deref(), check_opts)?
+        let searched = check_opts.self_intersections
+            && changes.solid.as_ref().is_some_and(|s| s.searched_free)
+            && same_facets(&written.mesh, &mesh);
+        let opts = CheckOptions {
+            self_intersections: check_opts.self_intersections && !searched,
+            ..*check_opts
+        };
+        let mut after = check(&written.mesh, written.normals.as_deref(), &opts)?;
+        if searched {
+            after.self_intersections = Some(0);
+            after.valid_solid = after.verdict().is_valid_solid();
+        }
+        after
     };
     let moved = changes.remesh_voxel.is_some()
         || changes

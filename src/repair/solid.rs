@@ -52,6 +52,10 @@ pub struct SolidReport {
     pub whole_part_remeshed: bool,
     /// The voxel size of the remeshes, mm, when one ran.
     pub voxel: Option<f64>,
+    /// The mesh returned was searched for intersecting facet pairs and has none (the search the
+    /// check of the written file may skip when the file holds the same facets).
+    #[serde(skip)]
+    pub searched_free: bool,
 }
 
 /// Joins intersecting shells of the closed, outward `mesh` into a solid; `voxel` is the remesh
@@ -65,6 +69,7 @@ pub fn unite(mesh: &Mesh, voxel: Option<f64>) -> Result<(Mesh, SolidReport)> {
         .collect();
     let (count, pairs) = soup_self_intersections(mesh, &all, usize::MAX);
     if count == 0 {
+        rep.searched_free = true;
         return Ok((mesh.clone(), rep));
     }
     let ns = shells.count();
@@ -143,6 +148,7 @@ pub fn unite(mesh: &Mesh, voxel: Option<f64>) -> Result<(Mesh, SolidReport)> {
     let out = crate::io::weld::weld_indexed(&out.positions, &out.indices)?;
     let found = check(&out, None, &CheckOptions::default())?;
     if found.defects().is_empty() {
+        rep.searched_free = found.self_intersections == Some(0);
         return Ok((out, rep));
     }
     rep.whole_part_remeshed = true;
