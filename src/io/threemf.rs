@@ -556,6 +556,20 @@ fn open<'a>(
         .ok_or_else(|| Error::parse(format!("<{element}> outside an <object>")))
 }
 
+/// The vertices and the open `<beamlattice>` of the object `current`, for its `<element>`.
+fn open_lattice<'a>(
+    objects: &'a mut HashMap<Key, Object>,
+    current: &Option<Key>,
+    element: &str,
+) -> Result<(&'a [f32], &'a mut LatticeDef)> {
+    let o = open(objects, current, element)?;
+    let l = o
+        .lattice
+        .as_mut()
+        .ok_or_else(|| Error::parse(format!("<{element}> outside a <beamlattice>")))?;
+    Ok((&o.positions, l))
+}
+
 /// Reads the objects of the model part `part` into `objects`, and its build items into `items`
 /// (the root part only). Returns the other parts its items and components name (`p:path`).
 fn parse_part(
@@ -660,12 +674,8 @@ fn parse_part(
                 o.lattice = Some(lattice_def(&e, scale)?);
             }
             "beam" => {
-                let o = open(objects, &current, "beam")?;
-                let nv = o.positions.len() / 3;
-                let l = o
-                    .lattice
-                    .as_mut()
-                    .ok_or_else(|| Error::parse("<beam> outside a <beamlattice>"))?;
+                let (positions, l) = open_lattice(objects, &current, "beam")?;
+                let nv = positions.len() / 3;
                 let ends: [u32; 2] = [num(&e, "v1")?, num(&e, "v2")?];
                 if ends.iter().any(|&i| i as usize >= nv) {
                     return Err(Error::parse(format!(
@@ -683,7 +693,7 @@ fn parse_part(
                 let caps = [cap(&e, "cap1", l.cap)?, cap(&e, "cap2", l.cap)?];
                 let p = |i: u32| {
                     let i = 3 * i as usize;
-                    [0, 1, 2].map(|a| o.positions[i + a] as f64)
+                    [0, 1, 2].map(|a| positions[i + a] as f64)
                 };
                 let (a, b) = (p(ends[0]), p(ends[1]));
                 let len = (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt();
@@ -701,12 +711,8 @@ fn parse_part(
                 *stored_beams += 1;
             }
             "ball" => {
-                let o = open(objects, &current, "ball")?;
-                let nv = o.positions.len() / 3;
-                let l = o
-                    .lattice
-                    .as_mut()
-                    .ok_or_else(|| Error::parse("<ball> outside a <beamlattice>"))?;
+                let (positions, l) = open_lattice(objects, &current, "ball")?;
+                let nv = positions.len() / 3;
                 let v: u32 = num(&e, "vindex")?;
                 if v as usize >= nv {
                     return Err(Error::parse(format!(
