@@ -38,7 +38,8 @@ remeshed. The result is one valid closed solid, or the reason none exists.
 of self-intersections at that resolution (details below a voxel are lost). auto: a quarter of
 the part's smallest feature (the shortest ray from a facet, along or against its normal, to
 another facet of its shell: a plate's thickness, a rod's diameter, a slot's gap), at most 1/64
-of the part, within a memory bound. With --solid, it sets the voxel of the remeshes the solid needs. When geometry moved,
+of the part, within a memory bound. With --solid, it sets the voxel of the remeshes the solid needs
+(shells that cross themselves are not measured for auto). When geometry moved,
 the deviation from the input is measured both ways (every vertex to the other mesh, CGAL).
 
 A 3MF file's beam lattices (Beam Lattice extension) are read as the solid they describe, meshed

@@ -106,6 +106,13 @@ const AUTO_MAX_ACTIVE: f64 = 4.0e6;
 /// thickness, a rod's or a hole's diameter, the gap of a slot. Shells are measured apart, so
 /// overlapping shells (which the remesh joins) do not count as thin.
 pub fn auto_voxel(mesh: &Mesh) -> f64 {
+    auto_voxel_skipping(mesh, &[])
+}
+
+/// [`auto_voxel`], with the shells marked in `skip` (by [`crate::mesh::topology::Shells`] index)
+/// left out of the smallest feature: a shell crossing itself has reaches down to nothing where
+/// it crosses, which say nothing of its features.
+pub fn auto_voxel_skipping(mesh: &Mesh, skip: &[bool]) -> f64 {
     use crate::mesh::topology::{Shells, Topology};
     let Some(b) = mesh.bounds() else {
         return 1.0;
@@ -125,8 +132,8 @@ pub fn auto_voxel(mesh: &Mesh) -> f64 {
     };
     let area_total: f64 = shells.members.iter().flatten().map(|&f| area(f)).sum();
     let mut smallest = f64::INFINITY;
-    for (members, edges) in shells.members.iter().zip(&shells.edges) {
-        if !edges.closed() {
+    for (s, (members, edges)) in shells.members.iter().zip(&shells.edges).enumerate() {
+        if !edges.closed() || skip.get(s).copied().unwrap_or(false) {
             continue;
         }
         let indices: Vec<u32> = members

@@ -89,7 +89,7 @@ pub fn unite(mesh: &Mesh, voxel: Option<f64>) -> Result<(Mesh, SolidReport)> {
     }
     let solid: Vec<bool> = shells.edges.iter().map(|e| e.solid()).collect();
     let depth = crate::check::nesting(mesh, &shells.members, &solid);
-    let voxel = voxel.unwrap_or_else(|| remesh::auto_voxel(mesh));
+    let voxel = voxel.unwrap_or_else(|| remesh::auto_voxel_skipping(mesh, &crossing_itself));
     let mut keep = vec![true; mesh.triangle_count()];
     let mut parts: Vec<Mesh> = Vec::new();
     for g in groups.values() {
