@@ -611,7 +611,7 @@ fn bad_fields_are_refused() {
     let vectors = dir.path().join("vectors.vdb");
     write_vdb_field(&vectors, "g = vdb.Vec3SGrid(); g.name = 'velocity'");
     let vectors = vectors.to_str().unwrap().to_string();
-    let cases: [(&[&str], &str); 14] = [
+    let cases: [(&[&str], &str); 20] = [
         (
             &["--blend-to", "q", "--blend-field", "x:0:1"],
             "unknown TPMS type 'q'",
@@ -1164,7 +1164,7 @@ fn a_spherical_shell_of_gyroid_cells_holds_the_density_in_every_cell() {
 #[test]
 fn bad_cell_maps_are_refused() {
     let dir = tempdir();
-    let cases: [(&[&str], &str); 14] = [
+    let cases: [(&[&str], &str); 20] = [
         (&["--cell-map", "cylindrical"], "--bore"),
         (
             &["--cell-map", "spherical", "--bore", "5", "--cells", "3,2,1"],
@@ -1240,6 +1240,27 @@ fn bad_cell_maps_are_refused() {
                 "4",
             ],
             "cannot be used with",
+        ),
+        (
+            &["--size", "20", "--cell-size-field", "3 - x/5"],
+            "a cell size is a positive length in mm",
+        ),
+        (
+            &["--size", "20", "--cell-size-field", "3 + * x"],
+            "cell-size expression '3 + * x', column 5",
+        ),
+        (&["--cell-size-field", "3"], "give the box with --size"),
+        (
+            &["--size", "20", "--cells", "4", "--cell-size-field", "3"],
+            "are not used",
+        ),
+        (
+            &["--size", "20", "--cell-size-field", "3 + d"],
+            "has no meaning here",
+        ),
+        (
+            &["--size", "20,20,2", "--cell-size-field", "6 + 5*sin((x+y)/3)"],
+            "cells would fold",
         ),
     ];
     refused(dir.path(), &["tpms", "-r", "8", "-o", "x.stl"], &cases);
@@ -1327,5 +1348,205 @@ fn cells_growing_along_an_axis_are_whole_and_hold_the_density() {
     for c in cells {
         let f = c[3].as_f64().unwrap();
         assert!((f - 0.3).abs() <= 0.005, "cell {c} holds {f:.4}");
+    }
+}
+
+/// Areas of the part's cross-sections at `heights` (manifold3d).
+fn slice_areas(stl: &Path, heights: &[f64]) -> Vec<f64> {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checkers/slice_areas.py");
+    let list: Vec<String> = heights.iter().map(|z| z.to_string()).collect();
+    let o = std::process::Command::new("python3")
+        .arg(script)
+        .arg(stl)
+        .arg(list.join(","))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+/// Cells sized by a field along z (`3 + z/6` mm through a 30 mm block at an odd origin): the
+/// faces are where the test's own integral of 1/s, scaled to whole cells, is whole — every
+/// cross-section there the same as the first (a cell out of place would change it), the
+/// mid-cell ones not; every cell (cut at those faces) within ±0.005 of the density; closed,
+/// clean by CGAL, one piece by manifold3d.
+#[test]
+fn cells_sized_by_a_field_along_an_axis_are_whole_and_hold_the_density() {
+    let dir = tempdir();
+    ok(
+        &[
+            "tpms",
+            "--size",
+            "15,15,30",
+            "--origin",
+            "1,-2,0.5",
+            "--cell-size-field",
+            "3 + z/6",
+            "-r",
+            "16",
+            "--verify",
+            "cgal",
+            "-q",
+            "-o",
+            "s.stl",
+            "--report",
+            "s.json",
+        ],
+        dir.path(),
+    );
+    let r = json(&dir.path().join("s.json"));
+    assert_clean_by_cgal(&r, "sized cells");
+    let map = &r["cell_map"];
+    assert_eq!(map["kind"], "sized");
+    // ∫dz/(3 + z/6) from 0.5 to 30.5 = 6·ln(s(30.5)/s(0.5)) = 5.78 → 6 cells; across, the mean
+    // of 15/s over z is 15·5.78/30 = 2.9 → 3 cells of 5 mm.
+    let s = |z: f64| 3.0 + z / 6.0;
+    let held = 6.0 * (s(30.5) / s(0.5)).ln();
+    assert_eq!(map["counts"], serde_json::json!([3, 3, 6]));
+    let faces: Vec<f64> = (0..=6)
+        .map(|i| {
+            // 6·Φ(z)/Φ(top) = i, Φ(z) = 6·ln(s(z)/s(0.5)).
+            let phi = i as f64 / 6.0 * held;
+            6.0 * (s(0.5) * (phi / 6.0).exp() - 3.0)
+        })
+        .collect();
+    assert!((faces[0] - 0.5).abs() < 1e-9 && (faces[6] - 30.5).abs() < 1e-9);
+    let inner: Vec<f64> = faces[1..6].to_vec();
+    let middles: Vec<f64> = faces.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();
+    let stl = dir.path().join("s.stl");
+    let at_faces = slice_areas(&stl, &inner);
+    let at_middles = slice_areas(&stl, &middles);
+    for a in &at_faces {
+        assert!(
+            (a / at_faces[0] - 1.0).abs() < 0.01,
+            "cross-sections at the faces {inner:?}: {at_faces:?}"
+        );
+    }
+    assert!(
+        (at_middles[2] / at_faces[0] - 1.0).abs() > 0.05,
+        "a mid-cell section differs from a face's: {at_middles:?} vs {at_faces:?}"
+    );
+    let given = format!(
+        "z:{}",
+        faces
+            .iter()
+            .map(|f| f.to_string())
+            .collect::<Vec<_>>()
+            .join(",")
+    );
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checkers/cell_density.py");
+    let o = std::process::Command::new("python3")
+        .arg(script)
+        .arg(&stl)
+        .args(["1,-2,0.5", "5,5,5", "15,15,30", &given])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(m["status"], "Error.NoError");
+    assert_eq!(m["components"], 1);
+    let cells = m["cells"].as_array().unwrap();
+    assert_eq!(cells.len(), 3 * 3 * 6);
+    for c in cells {
+        let f = c[3].as_f64().unwrap();
+        assert!((f - 0.3).abs() <= 0.005, "cell {c} holds {f:.4}");
+    }
+}
+
+/// Cells sized by a field that varies across the box (small at its axis, large at its sides)
+/// for random fields, boxes and origins: closed and clean by CGAL, one piece by manifold3d,
+/// the density over the box met; the counts are the test's own rounding of the mean integral
+/// of 1/s along each axis, and each face of the box a cell face (the cross-sections at two
+/// inner faces along z equal).
+#[test]
+fn cells_sized_by_random_fields_are_whole_and_hold_the_density() {
+    let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        (rng >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for case in 0..2 {
+        let dir = tempdir();
+        let size = [14.0 + 8.0 * next(), 14.0 + 8.0 * next(), 9.0 + 4.0 * next()];
+        let origin = [20.0 * next() - 10.0, 20.0 * next() - 10.0, 5.0 * next()];
+        let centre = [0, 1].map(|a| origin[a] + size[a] * (0.3 + 0.4 * next()));
+        let (base, slope) = (2.5 + next(), 0.1 + 0.1 * next());
+        let density = 0.2 + 0.15 * next();
+        let expr = format!(
+            "{base} + {slope}*sqrt((x-({}))^2 + (y-({}))^2)",
+            centre[0], centre[1]
+        );
+        let field = |p: [f64; 3]| {
+            base + slope * ((p[0] - centre[0]).powi(2) + (p[1] - centre[1]).powi(2)).sqrt()
+        };
+        let list = |v: [f64; 3]| v.map(|x| format!("{x}")).join(",");
+        let d = format!("{density}");
+        let (sz, or) = (list(size), list(origin));
+        let args = [
+            "tpms",
+            "--type",
+            ["gyroid", "d"][case],
+            "--density",
+            &d,
+            "--size",
+            &sz,
+            "--origin",
+            &or,
+            "--cell-size-field",
+            &expr,
+            "-r",
+            "12",
+            "--verify",
+            "cgal",
+            "-q",
+            "-o",
+            "s.stl",
+            "--report",
+            "s.json",
+        ];
+        ok(&args, dir.path());
+        let r = json(&dir.path().join("s.json"));
+        assert_clean_by_cgal(&r, &expr);
+        // The counts: the mean over lines along each axis of ∫dt/s, by the midpoint rule.
+        let counts: Vec<u64> = (0..3)
+            .map(|a| {
+                let (n, m) = (400, 24);
+                let mut sum = 0.0;
+                for i in 0..m {
+                    for j in 0..m {
+                        let mut p = origin;
+                        let others: Vec<usize> = (0..3).filter(|b| *b != a).collect();
+                        p[others[0]] += (i as f64 + 0.5) / m as f64 * size[others[0]];
+                        p[others[1]] += (j as f64 + 0.5) / m as f64 * size[others[1]];
+                        for k in 0..n {
+                            let mut q = p;
+                            q[a] = origin[a] + (k as f64 + 0.5) / n as f64 * size[a];
+                            sum += size[a] / n as f64 / field(q);
+                        }
+                    }
+                }
+                (sum / (m * m) as f64).round().max(1.0) as u64
+            })
+            .collect();
+        let map = &r["cell_map"];
+        assert_eq!(map["counts"], serde_json::json!(counts), "{expr}");
+        let stl = dir.path().join("s.stl");
+        let mesh = read_stl(&stl);
+        let measured = volume(&mesh) / (size[0] * size[1] * size[2]);
+        assert!(
+            (measured - density).abs() < 0.003,
+            "{expr}: {measured} for {density}"
+        );
+        let m = measure(&stl, origin, size, size);
+        assert_eq!(m.status, "Error.NoError", "{expr}");
+        assert_eq!(m.components, 1, "{expr}");
+        // The field does not vary along z: the faces along z are evenly spaced.
+        if counts[2] >= 3 {
+            let h = size[2] / counts[2] as f64;
+            let a = slice_areas(&stl, &[origin[2] + h, origin[2] + 2.0 * h]);
+            assert!((a[0] / a[1] - 1.0).abs() < 0.01, "{expr}: {a:?}");
+        }
     }
 }

@@ -62,6 +62,15 @@ impl GradeArgs {
 
 /// A field over `bounds`: an expression, a `.npy` array spanning it, or a `.vdb`'s grid.
 pub(crate) fn field(spec: &str, bounds: &latvox::field::Aabb) -> Result<DensityField> {
+    named_field(spec, bounds, "density")
+}
+
+/// [`field`] for a field that gives `noun` (a density, a cell size), named so in messages.
+pub(crate) fn named_field(
+    spec: &str,
+    bounds: &latvox::field::Aabb,
+    noun: &str,
+) -> Result<DensityField> {
     if spec.to_ascii_lowercase().ends_with(".vdb") {
         let (nodes, name) = latvox::grid::read_values(std::path::Path::new(spec))?;
         return Ok(DensityField::nodes(
@@ -69,7 +78,7 @@ pub(crate) fn field(spec: &str, bounds: &latvox::field::Aabb) -> Result<DensityF
             format!("grid '{name}' of {spec}"),
         ));
     }
-    DensityField::parse(spec, bounds)
+    DensityField::parse_named(spec, bounds, noun)
 }
 
 /// The density line of a graded part's summary.

@@ -35,6 +35,7 @@ const PART_KEYS: &[(&str, &[&str])] = &[
             "bore",
             "layers",
             "cell-size-grade",
+            "cell-size-field",
             "allow-islands",
         ],
     ),

@@ -58,6 +58,10 @@ Examples:
   # Cells 3 mm at the bottom of a 40 mm block growing to 8 mm at its top, each one whole
   latvox tpms --type gyroid --size 20,20,40 --cell-size 5 --cell-size-grade z:3:8 -o grown.stl
 
+  # Cells sized by a field: 3 mm along the axis of a 40 mm block growing to 7 mm at its sides
+  latvox tpms --type gyroid --size 40,40,20 --cell-size-field '3 + 0.2*sqrt((x-20)^2 + (y-20)^2)' \\
+      -o sized.stl
+
   # Save the part's settings as a part file; make it again, here with finer voxels
   latvox tpms --type d --density 0.25 --cells 4 -o d.stl --save-part d.toml
   latvox tpms --part d.toml --resolution 48 -o d-fine.stl
@@ -121,6 +125,19 @@ pub struct TpmsArgs {
     /// (the cell size along the other axes from --cell-size); no cell is torn.
     #[arg(long, value_name = "AXIS:A:B", conflicts_with = "cell_map")]
     pub cell_size_grade: Option<String>,
+    /// Size the cells by a field: the cell size in mm at each point, an expression in x, y, z
+    /// (as "3 + 0.1*sqrt((x-20)^2 + (y-20)^2)"), a .npy array spanning the box or a .vdb's
+    /// float grid. Every line of cells along an axis holds the same whole number of cells,
+    /// each stretched to the field's size along the line; no cell is torn. Where the field
+    /// varies across a line, the line's cells lean and keep its count (the report gives how
+    /// far each axis' cells came from the field).
+    #[arg(
+        long,
+        value_name = "EXPR|FILE.npy|FILE.vdb",
+        allow_hyphen_values = true,
+        conflicts_with_all = ["cell_map", "cell_size_grade"]
+    )]
+    pub cell_size_field: Option<String>,
     /// Inner radius of a --cell-map tube or shell, mm.
     #[arg(
         long,
@@ -175,10 +192,42 @@ pub fn execute(a: &TpmsArgs, progress: &latvox::progress::Progress) -> Result<Tp
 }
 
 impl TpmsArgs {
+    /// The box: from --size alone when a field sizes the cells.
+    fn domain(&self) -> Result<latvox::field::Domain> {
+        let d = &self.domain;
+        if self.cell_size_field.is_none() {
+            return d.domain();
+        }
+        match (d.size, d.cells, d.cell_size) {
+            (Some(s), None, None) => latvox::field::Domain::from_size_and_cell(s, s, d.origin),
+            (None, _, _) => Err(latvox::Error::invalid(
+                "--cell-size-field sizes the cells of a box: give the box with --size",
+            )),
+            _ => Err(latvox::Error::invalid(
+                "--cell-size-field gives the cells' size and count: --cells and --cell-size are not used",
+            )),
+        }
+    }
+
     /// The tube of a --cell-map part: cells around, through the wall and along from --cells
     /// (12,1,4 by default), their size through the wall and along from --cell-size (5 mm).
     fn cell_map(&self) -> Result<Option<latvox::field::cellmap::Mapping>> {
         use latvox::field::cellmap::{GradedCells, Mapping};
+        if let Some(f) = &self.cell_size_field {
+            let bounds = self.domain()?.bounds();
+            let field = super::lattice::named_field(f, &bounds, "cell-size")?;
+            if field.uses_distance() {
+                return Err(latvox::Error::invalid(
+                    "a cell-size field is in x, y and z: d (the depth below a filled part's skin) has no meaning here",
+                ));
+            }
+            return latvox::field::sizing::SizedCells::new(
+                bounds,
+                |p| field.at(p, 0.0),
+                field.source.clone(),
+            )
+            .map(|m| Some(Mapping::Sized(m)));
+        }
         if let Some(g) = &self.cell_size_grade {
             let bad = || {
                 latvox::Error::invalid(format!(
@@ -262,7 +311,7 @@ impl TpmsArgs {
         let m = &self.mesh;
         let o = m.options();
         let cell_map = self.cell_map()?;
-        let domain = self.domain.domain()?;
+        let domain = self.domain()?;
         let bounds = domain.bounds();
         let grading = self.grade.grading(&bounds)?;
         let structure =
@@ -342,6 +391,14 @@ fn print_tpms_summary(r: &TpmsReport) {
                 map.cells[1],
                 n = map.cells[0]
             ),
+        ),
+        Some(CellMapReport::Sized { field, fit, .. }) => (
+            format!(
+                "{blend}, cells sized by {field} ({} to {} mm)",
+                human(fit.asked[0], 4),
+                human(fit.asked[1], 4)
+            ),
+            cells,
         ),
         Some(CellMapReport::Graded { map, .. }) => (
             format!(

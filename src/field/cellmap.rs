@@ -28,7 +28,7 @@ use std::f64::consts::TAU;
 const FRAC_4_PI: f64 = 4.0 / std::f64::consts::PI;
 
 /// The cell maps a part can be made on.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone)]
 pub enum Mapping {
     /// Cells wrapped around an axis.
     Cylindrical(Cylindrical),
@@ -36,10 +36,12 @@ pub enum Mapping {
     Graded(GradedCells),
     /// Cells wrapped around a centre.
     Spherical(Spherical),
+    /// Cells of a box sized by a field.
+    Sized(super::sizing::SizedCells),
 }
 
 /// A map from space to cell coordinates, and the region its cells fill.
-pub trait CellMap: Copy + Send + Sync + std::fmt::Debug {
+pub trait CellMap: Clone + Send + Sync + std::fmt::Debug {
     /// Cell coordinates of `p` and the gradient of each (the Jacobian's rows), per mm.
     fn coords(&self, p: Vec3) -> (Vec3, [Vec3; 3]);
     /// A bound on `|∇(F∘u)|` per mm from bounds `l` on `|∂F/∂u_a|`, valid within
@@ -451,7 +453,7 @@ fn flux_within(
 /// Maps whose cells lie in layers between radii (a tube's wall, a shell's): the density of each
 /// layer is measured on the closed mesh, the solid within each radius by the divergence
 /// theorem.
-pub trait Layered: CellMap {
+pub trait Layered: CellMap + Copy {
     /// The radii between layers, bore outwards (one more than the layers).
     fn layer_radii(&self) -> Vec<f64>;
     /// The volume of the map's region between radii `r0` and `r1`, mm³.

@@ -82,12 +82,18 @@ impl DensityField {
 
     /// An expression, or a `.npy` file of samples spanning `bounds`.
     pub fn parse(spec: &str, bounds: &Aabb) -> Result<DensityField> {
+        Self::parse_named(spec, bounds, "density")
+    }
+
+    /// As [`DensityField::parse`], for a field named `noun` in messages (a density, a cell
+    /// size).
+    pub fn parse_named(spec: &str, bounds: &Aabb, noun: &str) -> Result<DensityField> {
         if spec.to_ascii_lowercase().ends_with(".npy") {
-            return Self::samples(Path::new(spec), bounds);
+            return Self::samples(Path::new(spec), bounds, noun);
         }
-        let text = normalise(spec)?;
+        let text = normalise(Source { text: spec, noun })?;
         let expr = exmex::parse::<f64>(&text)
-            .map_err(|e| Error::invalid(format!("density expression '{spec}': {e}")))?;
+            .map_err(|e| Error::invalid(format!("{noun} expression '{spec}': {e}")))?;
         let vars = expr
             .var_names()
             .iter()
@@ -109,14 +115,14 @@ impl DensityField {
 
     /// A `.npy` array of shape `(nx, ny, nz)`, each axis at least 2, its first and last samples
     /// on the box's faces.
-    fn samples(path: &Path, bounds: &Aabb) -> Result<DensityField> {
+    fn samples(path: &Path, bounds: &Aabb, noun: &str) -> Result<DensityField> {
         let bytes = std::fs::read(path)
             .map_err(|e| Error::invalid(format!("cannot read {}: {e}", path.display())))?;
         let a = crate::io::npy::parse(&bytes)
             .map_err(|e| Error::invalid(format!("{}: {e}", path.display())))?;
         if a.shape.len() != 3 || a.shape.iter().any(|&n| n < 2) {
             return Err(Error::invalid(format!(
-                "{}: a density field is a 3-D array of at least 2 samples per axis spanning the box, got shape {:?}",
+                "{}: a {noun} field is a 3-D array of at least 2 samples per axis spanning the box, got shape {:?}",
                 path.display(),
                 a.shape
             )));
@@ -187,8 +193,15 @@ enum Token {
     Op(char),
 }
 
-fn tokens(s: &str) -> Result<Vec<(Token, usize)>> {
-    let chars: Vec<char> = s.chars().collect();
+/// An expression's text and what it gives (for messages).
+#[derive(Clone, Copy)]
+struct Source<'a> {
+    text: &'a str,
+    noun: &'a str,
+}
+
+fn tokens(s: Source) -> Result<Vec<(Token, usize)>> {
+    let chars: Vec<char> = s.text.chars().collect();
     let mut out = Vec::new();
     let mut i = 0;
     while i < chars.len() {
@@ -235,9 +248,11 @@ fn tokens(s: &str) -> Result<Vec<(Token, usize)>> {
     Ok(out)
 }
 
-fn syntax(s: &str, col: usize, what: &str) -> Error {
+fn syntax(s: Source, col: usize, what: &str) -> Error {
     Error::invalid(format!(
-        "density expression '{s}', column {col}: {what} (names: x, y, z in mm, d the distance to the skin when filling; PI, E; functions: {}, {})",
+        "{} expression '{}', column {col}: {what} (names: x, y, z in mm, d the distance to the skin when filling; PI, E; functions: {}, {})",
+        s.noun,
+        s.text,
         FUNCTIONS.join(", "),
         FUNCTIONS2.join(", ")
     ))
@@ -245,7 +260,7 @@ fn syntax(s: &str, col: usize, what: &str) -> Error {
 
 /// Reads `s`, refusing it with the column of the first error, and returns it fully
 /// parenthesised for the evaluator.
-fn normalise(s: &str) -> Result<String> {
+fn normalise(s: Source) -> Result<String> {
     let toks = tokens(s)?;
     let mut r = Reader {
         s,
@@ -266,7 +281,7 @@ fn normalise(s: &str) -> Result<String> {
 }
 
 struct Reader<'a> {
-    s: &'a str,
+    s: Source<'a>,
     toks: &'a [(Token, usize)],
     at: usize,
 }
@@ -279,7 +294,7 @@ impl Reader<'_> {
     fn column(&self) -> usize {
         self.toks
             .get(self.at)
-            .map_or(self.s.chars().count() + 1, |t| t.1)
+            .map_or(self.s.text.chars().count() + 1, |t| t.1)
     }
 
     fn eat(&mut self, c: char) -> bool {

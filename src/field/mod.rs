@@ -12,6 +12,7 @@ pub mod density;
 pub mod domain;
 pub mod nodes;
 pub mod periodic;
+pub mod sizing;
 
 pub use domain::Domain;
 

@@ -169,8 +169,8 @@ impl TpmsJob {
     pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<TpmsReport> {
         let start = Instant::now();
         self.validate()?;
-        if let Some(map) = self.cell_map {
-            return self.run_mapped(map, progress, sink);
+        if let Some(map) = &self.cell_map {
+            return self.run_mapped(map.clone(), progress, sink);
         }
         if let Some(g) = &self.grading {
             return self.run_graded(g, progress, sink);

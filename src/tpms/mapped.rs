@@ -16,6 +16,7 @@ use super::job::TpmsJob;
 use super::{Structure, Surface, TpmsField, TpmsReport};
 use crate::error::{Error, Result};
 use crate::field::cellmap::{CellMap, Cylindrical, GradedCells, Layered, Mapping, Spherical};
+use crate::field::sizing::Fit;
 use crate::field::{intersection_clearance, Aabb, Field, Vec3};
 use crate::grid::GridSpec;
 use crate::io::sink::{MeshSink, Triangle};
@@ -26,7 +27,7 @@ use crate::progress::Progress;
 use std::time::Instant;
 
 /// A TPMS lattice on a cell map (cut by its region), at one level.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct MappedLattice<M> {
     /// Which minimal surface.
     pub surface: Surface,
@@ -134,7 +135,7 @@ impl<M: CellMap> Solid for MappedLattice<M> {
         );
         Box::new(MappedField {
             tpms,
-            map: self.map,
+            map: self.map.clone(),
             lipschitz: self.map.lipschitz(self.surface.lipschitz_per_axis()),
         })
     }
@@ -145,7 +146,7 @@ impl<M: CellMap> Solid for MappedLattice<M> {
 
     fn with_bounds(&self, _bounds: Aabb) -> Self {
         // Only periodic solids are clipped to other boxes (templates, calibration cells).
-        *self
+        self.clone()
     }
 
     fn period(&self) -> Option<Vec3> {
@@ -154,7 +155,7 @@ impl<M: CellMap> Solid for MappedLattice<M> {
 }
 
 /// The mapped lattice at every level; its density is its share of the map's region.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct MappedFamily<M> {
     /// The part at some level (replaced).
     pub part: MappedLattice<M>,
@@ -164,7 +165,10 @@ impl<M: CellMap> Family for MappedFamily<M> {
     type Solid = MappedLattice<M>;
 
     fn at(&self, level: f64) -> MappedLattice<M> {
-        MappedLattice { level, ..self.part }
+        MappedLattice {
+            level,
+            ..self.part.clone()
+        }
     }
 
     fn model_fraction(&self, level: f64) -> f64 {
@@ -222,6 +226,19 @@ pub enum CellMapReport {
         /// The cells' faces along the graded axis, mm.
         faces: Vec<f64>,
     },
+    /// Cells sized by a field.
+    Sized {
+        /// The box.
+        #[serde(rename = "box")]
+        bounds: Aabb,
+        /// Whole cells along each axis.
+        counts: [u32; 3],
+        /// The cell-size field, as given.
+        field: String,
+        /// How the cells came from the field.
+        #[serde(flatten)]
+        fit: Fit,
+    },
 }
 
 impl TpmsJob {
@@ -262,6 +279,28 @@ impl TpmsJob {
                 report.cell_map = Some(CellMapReport::Graded {
                     map,
                     faces: map.faces(),
+                });
+                Ok(report)
+            }
+            Mapping::Sized(map) => {
+                let fit = map.fit();
+                let mut report =
+                    self.run_on(map.clone(), "part with sized cells", progress, sink)?;
+                for (a, [lo, hi]) in fit.made_over_asked.iter().enumerate() {
+                    if *lo < 2.0 / 3.0 || *hi > 1.5 {
+                        report.part.warnings.push(format!(
+                            "cells across {} are {lo:.2}–{hi:.2}× the field's size: every line along {} holds the same {} whole cells, so a field that varies across it is followed only in its shape along the line",
+                            ["x", "y", "z"][a],
+                            ["x", "y", "z"][a],
+                            map.cell_counts()[a]
+                        ));
+                    }
+                }
+                report.cell_map = Some(CellMapReport::Sized {
+                    bounds: CellMap::bounds(&map),
+                    counts: map.cell_counts(),
+                    field: map.source().to_string(),
+                    fit,
                 });
                 Ok(report)
             }
@@ -342,7 +381,7 @@ impl TpmsJob {
                     surface: s,
                     structure: st,
                     level,
-                    map,
+                    map: map.clone(),
                 },
             };
             let route = Route::choose(&family.part, voxel, &opts);
