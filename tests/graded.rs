@@ -611,7 +611,7 @@ fn bad_fields_are_refused() {
     let vectors = dir.path().join("vectors.vdb");
     write_vdb_field(&vectors, "g = vdb.Vec3SGrid(); g.name = 'velocity'");
     let vectors = vectors.to_str().unwrap().to_string();
-    let cases: [(&[&str], &str); 20] = [
+    let cases: [(&[&str], &str); 14] = [
         (
             &["--blend-to", "q", "--blend-field", "x:0:1"],
             "unknown TPMS type 'q'",
@@ -1351,9 +1351,10 @@ fn cells_growing_along_an_axis_are_whole_and_hold_the_density() {
     }
 }
 
-/// Areas of the part's cross-sections at `heights` (manifold3d).
-fn slice_areas(stl: &Path, heights: &[f64]) -> Vec<f64> {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checkers/slice_areas.py");
+/// The share of each of the part's cross-sections at `heights` that the first one does not
+/// cover the same (their symmetric difference over the first one's area; manifold3d).
+fn slices_unlike_the_first(stl: &Path, heights: &[f64]) -> Vec<f64> {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checkers/slices.py");
     let list: Vec<String> = heights.iter().map(|z| z.to_string()).collect();
     let o = std::process::Command::new("python3")
         .arg(script)
@@ -1362,7 +1363,8 @@ fn slice_areas(stl: &Path, heights: &[f64]) -> Vec<f64> {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    serde_json::from_slice(&o.stdout).unwrap()
+    let v: Vec<[f64; 2]> = serde_json::from_slice(&o.stdout).unwrap();
+    v.iter().map(|[_, not_shared]| not_shared / v[0][0]).collect()
 }
 
 /// Cells sized by a field along z (`3 + z/6` mm through a 30 mm block at an odd origin): the
@@ -1411,21 +1413,18 @@ fn cells_sized_by_a_field_along_an_axis_are_whole_and_hold_the_density() {
         })
         .collect();
     assert!((faces[0] - 0.5).abs() < 1e-9 && (faces[6] - 30.5).abs() < 1e-9);
-    let inner: Vec<f64> = faces[1..6].to_vec();
-    let middles: Vec<f64> = faces.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();
+    // The inner faces, then the middles of the cells between them.
+    let mut heights: Vec<f64> = faces[1..6].to_vec();
+    heights.extend(faces[1..6].windows(2).map(|w| 0.5 * (w[0] + w[1])));
     let stl = dir.path().join("s.stl");
-    let at_faces = slice_areas(&stl, &inner);
-    let at_middles = slice_areas(&stl, &middles);
-    for a in &at_faces {
-        assert!(
-            (a / at_faces[0] - 1.0).abs() < 0.01,
-            "cross-sections at the faces {inner:?}: {at_faces:?}"
-        );
+    let unlike = slices_unlike_the_first(&stl, &heights);
+    for (z, u) in heights.iter().zip(&unlike) {
+        if heights[..5].contains(z) {
+            assert!(*u < 0.05, "the section at the face {z} is not the first's: {unlike:?}");
+        } else {
+            assert!(*u > 0.3, "the section mid-cell at {z} is a face's: {unlike:?}");
+        }
     }
-    assert!(
-        (at_middles[2] / at_faces[0] - 1.0).abs() > 0.05,
-        "a mid-cell section differs from a face's: {at_middles:?} vs {at_faces:?}"
-    );
     let given = format!(
         "z:{}",
         faces
@@ -1456,8 +1455,8 @@ fn cells_sized_by_a_field_along_an_axis_are_whole_and_hold_the_density() {
 /// Cells sized by a field that varies across the box (small at its axis, large at its sides)
 /// for random fields, boxes and origins: closed and clean by CGAL, one piece by manifold3d,
 /// the density over the box met; the counts are the test's own rounding of the mean integral
-/// of 1/s along each axis, and each face of the box a cell face (the cross-sections at two
-/// inner faces along z equal).
+/// of 1/s along each axis, the cross-sections at two inner faces along z the same, and every
+/// curved cell (`checkers/sized_cells.py`) within ±0.005 of the density.
 #[test]
 fn cells_sized_by_random_fields_are_whole_and_hold_the_density() {
     let mut rng = 0x9e37_79b9_7f4a_7c15u64;
@@ -1469,7 +1468,7 @@ fn cells_sized_by_random_fields_are_whole_and_hold_the_density() {
     };
     for case in 0..2 {
         let dir = tempdir();
-        let size = [14.0 + 8.0 * next(), 14.0 + 8.0 * next(), 9.0 + 4.0 * next()];
+        let size = [14.0 + 8.0 * next(), 14.0 + 8.0 * next(), 16.0 + 4.0 * next()];
         let origin = [20.0 * next() - 10.0, 20.0 * next() - 10.0, 5.0 * next()];
         let centre = [0, 1].map(|a| origin[a] + size[a] * (0.3 + 0.4 * next()));
         let (base, slope) = (2.5 + next(), 0.1 + 0.1 * next());
@@ -1542,11 +1541,36 @@ fn cells_sized_by_random_fields_are_whole_and_hold_the_density() {
         let m = measure(&stl, origin, size, size);
         assert_eq!(m.status, "Error.NoError", "{expr}");
         assert_eq!(m.components, 1, "{expr}");
-        // The field does not vary along z: the faces along z are evenly spaced.
-        if counts[2] >= 3 {
-            let h = size[2] / counts[2] as f64;
-            let a = slice_areas(&stl, &[origin[2] + h, origin[2] + 2.0 * h]);
-            assert!((a[0] / a[1] - 1.0).abs() < 0.01, "{expr}: {a:?}");
+        // The field does not vary along z: the faces along z are evenly spaced, and the
+        // sections at two inner ones the same.
+        assert!(counts[2] >= 3, "{expr}: {counts:?}");
+        let h = size[2] / counts[2] as f64;
+        let u = slices_unlike_the_first(&stl, &[origin[2] + h, origin[2] + 2.0 * h]);
+        assert!(u[1] < 0.05, "{expr}: {u:?}");
+        // Every cell, curved as the field makes it (its faces computed by the checker from the
+        // field's formula), within ±0.005 of the density.
+        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checkers/sized_cells.py");
+        let o = std::process::Command::new("python3")
+            .arg(script)
+            .arg(&stl)
+            .args([
+                or.as_str(),
+                sz.as_str(),
+                &counts.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(","),
+                &format!("radial:{base},{slope},{},{}", centre[0], centre[1]),
+            ])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let cells: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let cells = cells["cells"].as_array().unwrap();
+        assert_eq!(cells.len() as u64, counts.iter().product::<u64>());
+        for c in cells {
+            let f = c[3].as_f64().unwrap();
+            assert!(
+                (f - density).abs() <= 0.005,
+                "{expr}: cell {c} holds {f:.4} for {density:.4}"
+            );
         }
     }
 }
