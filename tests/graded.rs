@@ -1259,7 +1259,12 @@ fn bad_cell_maps_are_refused() {
             "has no meaning here",
         ),
         (
-            &["--size", "20,20,2", "--cell-size-field", "6 + 5*sin((x+y)/3)"],
+            &[
+                "--size",
+                "20,20,2",
+                "--cell-size-field",
+                "6 + 5*sin((x+y)/3)",
+            ],
             "cells would fold",
         ),
     ];
@@ -1364,7 +1369,9 @@ fn slices_unlike_the_first(stl: &Path, heights: &[f64]) -> Vec<f64> {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: Vec<[f64; 2]> = serde_json::from_slice(&o.stdout).unwrap();
-    v.iter().map(|[_, not_shared]| not_shared / v[0][0]).collect()
+    v.iter()
+        .map(|[_, not_shared]| not_shared / v[0][0])
+        .collect()
 }
 
 /// Cells sized by a field along z (`3 + z/6` mm through a 30 mm block at an odd origin): the
@@ -1420,9 +1427,15 @@ fn cells_sized_by_a_field_along_an_axis_are_whole_and_hold_the_density() {
     let unlike = slices_unlike_the_first(&stl, &heights);
     for (z, u) in heights.iter().zip(&unlike) {
         if heights[..5].contains(z) {
-            assert!(*u < 0.05, "the section at the face {z} is not the first's: {unlike:?}");
+            assert!(
+                *u < 0.05,
+                "the section at the face {z} is not the first's: {unlike:?}"
+            );
         } else {
-            assert!(*u > 0.3, "the section mid-cell at {z} is a face's: {unlike:?}");
+            assert!(
+                *u > 0.3,
+                "the section mid-cell at {z} is a face's: {unlike:?}"
+            );
         }
     }
     let given = format!(
@@ -1468,7 +1481,11 @@ fn cells_sized_by_random_fields_are_whole_and_hold_the_density() {
     };
     for case in 0..2 {
         let dir = tempdir();
-        let size = [14.0 + 8.0 * next(), 14.0 + 8.0 * next(), 16.0 + 4.0 * next()];
+        let size = [
+            14.0 + 8.0 * next(),
+            14.0 + 8.0 * next(),
+            16.0 + 4.0 * next(),
+        ];
         let origin = [20.0 * next() - 10.0, 20.0 * next() - 10.0, 5.0 * next()];
         let centre = [0, 1].map(|a| origin[a] + size[a] * (0.3 + 0.4 * next()));
         let (base, slope) = (2.5 + next(), 0.1 + 0.1 * next());
@@ -1556,7 +1573,11 @@ fn cells_sized_by_random_fields_are_whole_and_hold_the_density() {
             .args([
                 or.as_str(),
                 sz.as_str(),
-                &counts.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(","),
+                &counts
+                    .iter()
+                    .map(|c| c.to_string())
+                    .collect::<Vec<_>>()
+                    .join(","),
                 &format!("radial:{base},{slope},{},{}", centre[0], centre[1]),
             ])
             .output()

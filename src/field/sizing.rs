@@ -82,7 +82,9 @@ impl SizedCells {
         use rayon::prelude::*;
         let extent = bounds.size();
         if !extent.iter().all(|e| *e > 0.0 && e.is_finite()) {
-            return Err(Error::invalid("the box of a cell-size field must have a size"));
+            return Err(Error::invalid(
+                "the box of a cell-size field must have a size",
+            ));
         }
         // A first look at the field (32 nodes a side) for its smallest size.
         let probe = Nodes::sample(bounds.min, extent.map(|e| e / 31.0), [32; 3], &size);
@@ -159,7 +161,11 @@ impl SizedCells {
 /// Refuses a field that is not a positive, finite length at some node, naming the node.
 fn check_sizes(nodes: &Nodes) -> Result<()> {
     let n = nodes.n;
-    if let Some(i) = nodes.values.iter().position(|v| !(*v > 0.0 && v.is_finite())) {
+    if let Some(i) = nodes
+        .values
+        .iter()
+        .position(|v| !(*v > 0.0 && v.is_finite()))
+    {
         let c = [i / (n[1] * n[2]), i / n[2] % n[1], i % n[2]];
         let p = [0, 1, 2].map(|a| nodes.origin[a] + c[a] as f64 * nodes.step[a]);
         return Err(Error::invalid(format!(
@@ -246,7 +252,7 @@ impl Tables {
                 let det = j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1])
                     - j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0])
                     + j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0]);
-                if !(det > 0.0) && acc.fold.is_none() {
+                if (det <= 0.0 || det.is_nan()) && acc.fold.is_none() {
                     acc.fold = Some(p);
                 }
                 let asked = 1.0 / inverse.at(p);
@@ -267,7 +273,10 @@ impl Tables {
                     for b in 0..3 {
                         x.gram[a][b] = x.gram[a][b].max(y.gram[a][b]);
                     }
-                    x.ratio[a] = [x.ratio[a][0].min(y.ratio[a][0]), x.ratio[a][1].max(y.ratio[a][1])];
+                    x.ratio[a] = [
+                        x.ratio[a][0].min(y.ratio[a][0]),
+                        x.ratio[a][1].max(y.ratio[a][1]),
+                    ];
                 }
                 x.shortest = x.shortest.min(y.shortest);
                 x.fold = x.fold.or(y.fold);
@@ -420,9 +429,15 @@ mod tests {
             .unwrap()
             .to_string();
         assert!(e.contains("positive length") && e.contains('('), "{e}");
-        let e = SizedCells::new(block(), |_| f64::NAN, String::new()).err().unwrap().to_string();
+        let e = SizedCells::new(block(), |_| f64::NAN, String::new())
+            .err()
+            .unwrap()
+            .to_string();
         assert!(e.contains("NaN"), "{e}");
-        let e = SizedCells::new(block(), |_| 0.001, String::new()).err().unwrap().to_string();
+        let e = SizedCells::new(block(), |_| 0.001, String::new())
+            .err()
+            .unwrap()
+            .to_string();
         assert!(e.contains("too many cells"), "{e}");
     }
 }
