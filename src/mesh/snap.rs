@@ -18,8 +18,10 @@
 //! tip a sliver triangle through its neighbour: every triangle whose normal turned by more than
 //! [`MAX_TURN_DEGREES`] is found and its vertices are returned to OpenVDB's positions, repeatedly,
 //! until none is. And where a thin member meets the box, two vertices snapped onto the face can
-//! swap places along it without turning a triangle over: triangles on the box's faces that cross
-//! one another are found exactly and their vertices restored the same way.
+//! swap places along it without turning a triangle over, and where two sheets of the surface
+//! pass through one voxel (a neck or a wall thinner than a voxel) their snapped triangles can
+//! cross: triangles there that cross one another are found exactly and their vertices restored
+//! the same way.
 
 use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
@@ -103,7 +105,7 @@ pub fn snap_within(
         }
     }
     mesh.triangulate();
-    s.restored = unfold(mesh, spec) + untangle_rims(mesh, clip, spec);
+    s.restored = unfold(mesh, spec) + untangle(mesh, clip, spec);
     s
 }
 
@@ -145,21 +147,37 @@ pub fn unfold(mesh: &mut KeyedMesh, spec: &GridSpec) -> u64 {
     restored
 }
 
-/// Returns to OpenVDB's positions the vertices of triangles on the clip box's faces (two or
-/// more corners on a face) that snapping left crossing one another: where a thin member meets
-/// the box, two rim vertices snapped onto the face's curve from neighbouring cells can swap
-/// places along it without turning either triangle over. Each rim triangle is tested exactly
-/// against those of its voxel's neighbours; repeats for at most [`UNFOLD_PASSES`] passes. Returns
-/// how many were restored.
-fn untangle_rims(mesh: &mut KeyedMesh, clip: &Aabb, spec: &GridSpec) -> u64 {
+/// Returns to OpenVDB's positions the vertices of triangles that snapping left crossing one
+/// another where they can: on the clip box's faces (two or more corners on a face: where a thin
+/// member meets the box, two rim vertices snapped onto the face's curve from neighbouring cells
+/// can swap places along it without turning either triangle over), and where two sheets of the
+/// surface pass through one voxel (a voxel holding vertices of two edge groups: a neck or a
+/// wall thinner than a voxel, whose two sides snapped onto the exact surface can cross). Each
+/// such triangle is tested exactly against the others within a voxel of it; repeats for at
+/// most [`UNFOLD_PASSES`] passes. Returns how many were restored.
+fn untangle(mesh: &mut KeyedMesh, clip: &Aabb, spec: &GridSpec) -> u64 {
     use crate::check::self_intersect::exact::{facets_intersect, Facet};
     use crate::mesh::{cross, norm, sub};
     use std::collections::HashMap;
     let on_clip = |p: Vec3| (0..3).any(|a| p[a] == clip.min[a] || p[a] == clip.max[a]);
+    // The vertices in voxels holding more than one: two sheets pass through those.
+    let shared: Vec<bool> = {
+        let mut order: Vec<u32> = (0..mesh.keys.len() as u32).collect();
+        order.par_sort_unstable_by_key(|v| mesh.keys[*v as usize].voxel);
+        let mut shared = vec![false; mesh.keys.len()];
+        for w in order.windows(2) {
+            let [a, b] = [w[0] as usize, w[1] as usize];
+            if mesh.keys[a].voxel == mesh.keys[b].voxel {
+                shared[a] = true;
+                shared[b] = true;
+            }
+        }
+        shared
+    };
     let mut restored = 0u64;
     for _ in 0..UNFOLD_PASSES {
         let m = &*mesh;
-        let rims: Vec<[u32; 3]> = (0..m.quads.len())
+        let tangled: Vec<[u32; 3]> = (0..m.quads.len())
             .into_par_iter()
             .flat_map_iter(|q| {
                 let (t, u) = m.quad_triangles(q);
@@ -167,34 +185,39 @@ fn untangle_rims(mesh: &mut KeyedMesh, clip: &Aabb, spec: &GridSpec) -> u64 {
             })
             .filter(|t| {
                 let p = t.map(|v| m.positions[v as usize]);
-                p.iter().filter(|p| on_clip(**p)).count() >= 2
+                (p.iter().filter(|p| on_clip(**p)).count() >= 2
+                    || t.iter().any(|v| shared[*v as usize]))
                     && norm(cross(sub(p[1], p[0]), sub(p[2], p[0]))) > 0.0
             })
             .collect();
-        if rims.is_empty() {
+        if tangled.is_empty() {
             break;
         }
+        // A triangle's corners lie in voxels next to one another (each vertex stays in its
+        // voxel), so the triangle lies in the 2³ voxels from its corners' lowest: two triangles
+        // that meet have lowest voxels at most one apart.
+        let lowest = |t: &[u32; 3]| {
+            let k = t.map(|v| m.keys[v as usize].voxel);
+            [0, 1, 2].map(|a| k[0][a].min(k[1][a]).min(k[2][a]))
+        };
         let mut cells: HashMap<[i32; 3], Vec<usize>> = HashMap::new();
-        for (i, t) in rims.iter().enumerate() {
-            cells
-                .entry(m.keys[t[0] as usize].voxel)
-                .or_default()
-                .push(i);
+        for (i, t) in tangled.iter().enumerate() {
+            cells.entry(lowest(t)).or_default().push(i);
         }
         let facet = |t: &[u32; 3]| Facet::new(*t, t.map(|v| m.positions[v as usize]));
-        let bad: Vec<u32> = (0..rims.len())
+        let bad: Vec<u32> = (0..tangled.len())
             .into_par_iter()
             .flat_map_iter(|i| {
-                let (t, k) = (rims[i], m.keys[rims[i][0] as usize].voxel);
+                let (t, k) = (tangled[i], lowest(&tangled[i]));
                 let f = facet(&t);
                 let mut out = Vec::new();
                 for n in 0..27 {
                     let d = [n / 9, n / 3 % 3, n % 3].map(|x| x - 1);
                     let key = [k[0] + d[0], k[1] + d[1], k[2] + d[2]];
                     for &j in cells.get(&key).map_or(&[][..], Vec::as_slice) {
-                        if j > i && facets_intersect(&f, &facet(&rims[j])) {
+                        if j > i && facets_intersect(&f, &facet(&tangled[j])) {
                             out.extend(t);
-                            out.extend(rims[j]);
+                            out.extend(tangled[j]);
                         }
                     }
                 }
