@@ -120,6 +120,38 @@ impl CellVolumes {
         }
     }
 
+    /// Takes `volume` (a piece of the mesh dropped after it was measured) from the cells that
+    /// `within`, the piece's bounds, reaches, in proportion to how much of each it covers.
+    pub fn remove(&mut self, volume: f64, within: &Aabb) {
+        let (Some((i0, i1)), Some((j0, j1)), Some((k0, k1))) = (
+            self.span(0, within.min[0], within.max[0]),
+            self.span(1, within.min[1], within.max[1]),
+            self.span(2, within.min[2], within.max[2]),
+        ) else {
+            return;
+        };
+        let overlap = |c: [usize; 3]| {
+            let b = self.cell_box(c);
+            (0..3)
+                .map(|a| (b.max[a].min(within.max[a]) - b.min[a].max(within.min[a])).max(0.0))
+                .product::<f64>()
+        };
+        let reached: Vec<([usize; 3], f64)> = (i0..=i1)
+            .flat_map(|i| (j0..=j1).flat_map(move |j| (k0..=k1).map(move |k| [i, j, k])))
+            .map(|c| (c, overlap(c)))
+            .collect();
+        let total: f64 = reached.iter().map(|r| r.1).sum();
+        for (c, o) in reached {
+            let share = if total > 0.0 {
+                o / total
+            } else {
+                1.0 / ((i1 - i0 + 1) * (j1 - j0 + 1) * (k1 - k0 + 1)) as f64
+            };
+            let at = self.index(c);
+            self.inside[at] -= volume * share;
+        }
+    }
+
     /// Adds the cells of another pass over other triangles of the same mesh.
     pub fn merge(&mut self, o: &CellVolumes) {
         for (a, b) in self.inside.iter_mut().zip(&o.inside) {

@@ -319,6 +319,19 @@ pub fn measure<F: Family>(
     route: Route,
     o: &Options,
 ) -> Result<Measured> {
+    measure_observed(family, level, voxel, route, o, &mut VolumeSink)
+}
+
+/// [`measure`], the triangles of a part measured tile by tile without a template (nothing
+/// held) passed to `observer` as they are meshed (fragments included).
+pub fn measure_observed<F: Family>(
+    family: &F,
+    level: f64,
+    voxel: f64,
+    route: Route,
+    o: &Options,
+    observer: &mut dyn MeshSink,
+) -> Result<Measured> {
     let solid = family.at(level);
     let template = |plan| Template::build(&solid, voxel, plan, o.keep_fragments);
     let (made, volume, fragments, meshing) = match route {
@@ -346,7 +359,7 @@ pub fn measure<F: Family>(
         }
         Route::Tiled(edge, None) => {
             // No template: the part's volume and pieces are found tile by tile, nothing written.
-            let (v, stats, found) = tiled_volume(&solid, voxel, edge, true)?;
+            let (v, stats, found) = tiled_volume(&solid, voxel, edge, true, observer)?;
             let found = found.expect("pieces were asked for");
             let mut f = found.fragments;
             f.removed = !o.keep_fragments;
@@ -368,7 +381,7 @@ pub fn measure<F: Family>(
 pub fn solid_volume<S: Solid>(solid: &S, voxel: f64, route: Route) -> Result<(f64, MeshingStats)> {
     match route {
         Route::Tiled(edge, _) => {
-            tiled_volume(solid, voxel, edge, false).map(|(v, stats, _)| (v, stats))
+            tiled_volume(solid, voxel, edge, false, &mut VolumeSink).map(|(v, stats, _)| (v, stats))
         }
         _ => {
             let (mesh, stats) = mesh_keyed(solid, part_spec(solid, voxel), None, 0.0, None)?;
@@ -394,6 +407,7 @@ fn tiled_volume<S: Solid>(
     voxel: f64,
     edge: i64,
     find_pieces: bool,
+    sink: &mut dyn MeshSink,
 ) -> Result<(f64, MeshingStats, Option<tile::TiledPieces>)> {
     let spec = part_spec(solid, voxel);
     let stats = std::sync::Mutex::new(MeshingStats::default());
@@ -405,7 +419,6 @@ fn tiled_volume<S: Solid>(
             .add(&s);
         Ok(m)
     };
-    let mut sink = VolumeSink;
     let out = tile::mesh_tiled(
         spec.padded_region(),
         edge,
@@ -417,7 +430,7 @@ fn tiled_volume<S: Solid>(
             tile::Pieces::Keep
         },
         &Progress::hidden(),
-        &mut sink,
+        sink,
     )?;
     Ok((
         out.measures.volume,
@@ -428,7 +441,7 @@ fn tiled_volume<S: Solid>(
 
 /// A sink that keeps nothing (tiles are measured as they pass).
 #[derive(Default)]
-struct VolumeSink;
+pub struct VolumeSink;
 
 impl MeshSink for VolumeSink {
     fn begin(&mut self, _: Option<u64>) -> Result<()> {

@@ -155,6 +155,8 @@ pub struct TiledPieces {
     kept: Vec<bool>,
     /// The fragments (set by [`TiledPieces::finish`]).
     pub fragments: Fragments,
+    /// Each fragment's volume, mm³, and bounds (set by [`TiledPieces::finish`]).
+    pub loose: Vec<(f64, Aabb)>,
 }
 
 /// Whether a vertex in voxel `v` may be on triangles of another tile than `own`: a quad is
@@ -216,6 +218,10 @@ impl TiledPieces {
         }
         let kept = pieces::kept_shells(&piece_volume, &piece_bounds);
         self.fragments = pieces::fragments_of(&piece_volume, &kept, false);
+        self.loose = (0..kept.len())
+            .filter(|&p| !kept[p])
+            .map(|p| (piece_volume[p], piece_bounds[p]))
+            .collect();
         self.kept = of.iter().map(|&p| kept[p as usize]).collect();
         self.volume = Vec::new();
         self.bounds = Vec::new();

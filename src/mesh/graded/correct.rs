@@ -106,29 +106,52 @@ pub fn mesh<G: Graded>(
     };
     let mut levels = build(&shift);
     let mut brackets = vec![Bracket::default(); promised.len()];
-    let mut best: Option<(f64, pipeline::Measured)> = None;
+    // The worst cell's miss, the meshing and the shifts it was made with.
+    let mut best: Option<(f64, pipeline::Measured, Vec<f64>)> = None;
     let mut meshings = 0u32;
     let mut tried = Vec::new();
     let mut search_meshing = MeshingStats::default();
     let route = Route::choose(&kind.family(&levels).at(0.0), voxel, opts);
     let measured = loop {
+        // A part meshed tile by tile is measured cell by cell as its tiles pass.
+        let mut observer = CellTee {
+            inner: &mut pipeline::VolumeSink,
+            cells: grid.clone(),
+        };
         let m = {
             let _p = progress.stage(if meshings == 0 {
                 "sampling and meshing the graded part"
             } else {
                 "meshing the part again with its cells corrected"
             });
-            pipeline::measure(&kind.family(&levels), 0.0, voxel, route, opts)?
+            pipeline::measure_observed(
+                &kind.family(&levels),
+                0.0,
+                voxel,
+                route,
+                opts,
+                &mut observer,
+            )?
         };
         meshings += 1;
         search_meshing.add(&m.meshing);
         tried.push((0.0, m.fraction));
-        let Made::Whole(mesh) = &m.made else {
-            break m;
+        let measured = match &m.made {
+            Made::Whole(mesh) => {
+                let mut measured = grid.clone();
+                measured.add_mesh(&mesh.to_mesh());
+                measured.fractions()
+            }
+            Made::TilePieces(found) => {
+                // The fragments are dropped when the part is written.
+                let mut cells = observer.cells;
+                for (volume, within) in &found.loose {
+                    cells.remove(*volume, within);
+                }
+                cells.fractions()
+            }
+            _ => break m,
         };
-        let mut measured = grid.clone();
-        measured.add_mesh(&mesh.to_mesh());
-        let measured = measured.fractions();
         let worst = (0..promised.len())
             .filter(|&i| promised[i])
             .map(|i| (measured[i] - targets[i]).abs())
@@ -136,10 +159,15 @@ pub fn mesh<G: Graded>(
         let done = worst <= AIM || meshings >= MAX_MESHINGS;
         // The meshing whose worst cell is closest is written.
         if best.as_ref().is_none_or(|b| worst < b.0) {
-            best = Some((worst, m));
+            best = Some((worst, m, shift.clone()));
         }
         if done {
-            break best.take().expect("a meshing was kept").1;
+            let (_, m, best_shift) = best.take().expect("a meshing was kept");
+            if best_shift != shift {
+                // Tiles are meshed again as they are written: at the best meshing's levels.
+                levels = build(&best_shift);
+            }
+            break m;
         }
         for i in 0..promised.len() {
             if promised[i] {

@@ -15,8 +15,9 @@
 //! ([`super::cells`]), and each cell's density shifted by its error (the shift read
 //! trilinearly between cell centres, so the correction has no seam) until every promised cell
 //! is within [`AIM`] of the field at its centre, or [`MAX_MESHINGS`] meshings ([`mesh`]). Parts
-//! meshed in tiles are written from the first meshing; their cells are measured as they are
-//! written.
+//! meshed in tiles are corrected the same way: each meshing's cells are measured as its tiles
+//! pass (nothing held), the fragments it drops taken from the cells their bounds cover, and the
+//! best meshing's levels are meshed again as they are written.
 //!
 //! [`levels`] holds the level (the map, the grid, the graded part), [`correct`] the meshing and
 //! the per-cell correction; this module the grading's setting, checks and reports.
