@@ -1627,6 +1627,43 @@ fn a_graded_part_meshed_in_tiles_meets_the_field_in_every_cell() {
     );
 }
 
+/// A diamond net graded so that two layers of whole cells sit at 0.10–0.11, where its members
+/// are too thin for 16 voxels per cell and break loose (those cells came out empty): the part is
+/// meshed again on finer voxels, said in a warning, and every cell meets the field.
+#[test]
+fn cells_whose_members_break_loose_are_met_on_finer_voxels() {
+    let args = [
+        "tpms",
+        "--type",
+        "d",
+        "--density-field",
+        "0.1 + 0.3*(z/30)^3",
+        "--cells",
+        "6,2,6",
+        "-r",
+        "16",
+    ];
+    check_graded(&args, [0.0; 3], [5.0; 3], [30.0, 10.0, 30.0], &|p| {
+        0.1 + 0.3 * (p[2] / 30.0).powi(3)
+    });
+    let dir = tempdir();
+    let mut all = args.to_vec();
+    all.extend(["-q", "-o", "p.stl", "--report", "p.json"]);
+    ok(&all, dir.path());
+    let r = json(&dir.path().join("p.json"));
+    assert!(
+        r["resolution"].as_u64().unwrap() > 16,
+        "{}",
+        r["resolution"]
+    );
+    let warned = r["warnings"].as_array().unwrap().iter().any(|w| {
+        w.as_str()
+            .unwrap()
+            .contains("cells missed the field at 16 voxels per cell")
+    });
+    assert!(warned, "{}", r["warnings"]);
+}
+
 /// Spherical shells of the types whose members pinch where the cubed sphere narrows its cells
 /// (two sheets of the surface through one voxel, snapped onto the exact surface, used to cross):
 /// CGAL finds each closed and free of self-intersections at coarse voxels.

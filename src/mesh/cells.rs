@@ -234,8 +234,23 @@ impl MeshSink for CellTee<'_> {
     }
 
     fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
-        for t in batch {
-            self.cells.add(t.map(|p| p.map(|x| x as f64)));
+        use rayon::prelude::*;
+        // Fixed chunks merged in order: the same sums whatever the scheduling; each chunk
+        // worth the cells' copy it fills.
+        let empty = CellVolumes::new(self.cells.bounds, self.cells.cell);
+        let chunk = (1usize << 15).max(8 * empty.inside.len());
+        let parts: Vec<CellVolumes> = batch
+            .par_chunks(chunk)
+            .map(|chunk| {
+                let mut v = empty.clone();
+                for t in chunk {
+                    v.add(t.map(|p| p.map(|x| x as f64)));
+                }
+                v
+            })
+            .collect();
+        for p in &parts {
+            self.cells.merge(p);
         }
         self.inner.triangles(batch)
     }

@@ -14,6 +14,11 @@ use crate::grid::GridSpec;
 use crate::io::sink::MeshSink;
 use crate::mesh::graded::{self, Feasible, Grading, LevelGrid, LevelMap, Levelled, Mapped, Run};
 use crate::mesh::report::Timings;
+
+/// Times a graded part whose cells miss the field is meshed again on finer voxels.
+const MAX_RAISES: u32 = 2;
+/// How much finer each time.
+const RAISE: f64 = 1.25;
 use crate::progress::Progress;
 use std::time::Instant;
 
@@ -203,58 +208,75 @@ impl TpmsJob {
             .chain(self.blend.as_ref().map(|b| b.to))
             .filter_map(thin)
             .max_by_key(|(r, _)| *r);
-        let (resolution, warnings) =
+        let (mut resolution, mut warnings) =
             graded::raised(self.resolution, thinnest, self.auto_resolution, "perforate")?;
-        let voxel = cell.iter().cloned().fold(f64::INFINITY, f64::min) / resolution as f64;
-        let cal_start = Instant::now();
-        let (lo, hi) = (targets.built[0], targets.built[1]);
-        let calibrate =
-            |surface: Surface| Calibrated::build(surface, st, cell, voxel, self.adaptivity, lo, hi);
-        let (calibrated, other) = {
-            let _p = progress.stage("calibrating the density → level map");
-            (
-                calibrate(s)?,
-                self.blend.as_ref().map(|b| calibrate(b.to)).transpose()?,
-            )
-        };
-        let calibrate_seconds = cal_start.elapsed().as_secs_f64();
-        let lattice = Lattice {
-            surface: s,
-            structure: st,
-            level: calibrated.middle.level,
-            cell,
-            bounds,
-            phase: bounds.min,
-        };
         let opts = self.options(false, false);
-        let run = Run {
-            grading,
-            targets,
-            feasible,
-            voxel,
-            resolution,
-            options: opts,
-            calibrated: calibrated.converged && other.as_ref().is_none_or(|o| o.converged),
-            timings: Timings {
-                calibrate: calibrate_seconds,
-                ..Timings::default()
-            },
-            warnings,
-            start,
-        };
-        let done = match (&self.blend, &other) {
-            (Some(blend), Some(other)) => {
-                let margin = (crate::mesh::pipeline::HALF_WIDTH + 2.0) * voxel;
-                let kind = BlendMapped::new(lattice, blend, margin, (lo, hi), &calibrated, other);
-                run.in_box(&kind, bounds, cell, progress, sink)?
+        // Members too thin for the voxels break loose, and the cells they leave miss the field:
+        // such a part is meshed again on finer voxels (twice at most) before it is written.
+        let mut raises = 0;
+        let (done, calibrated, voxel) = loop {
+            let voxel = cell.iter().cloned().fold(f64::INFINITY, f64::min) / resolution as f64;
+            let cal_start = Instant::now();
+            let (lo, hi) = (targets.built[0], targets.built[1]);
+            let calibrate = |surface: Surface| {
+                Calibrated::build(surface, st, cell, voxel, self.adaptivity, lo, hi)
+            };
+            let (calibrated, other) = {
+                let _p = progress.stage("calibrating the density → level map");
+                (
+                    calibrate(s)?,
+                    self.blend.as_ref().map(|b| calibrate(b.to)).transpose()?,
+                )
+            };
+            let calibrate_seconds = cal_start.elapsed().as_secs_f64();
+            let lattice = Lattice {
+                surface: s,
+                structure: st,
+                level: calibrated.middle.level,
+                cell,
+                bounds,
+                phase: bounds.min,
+            };
+            let run = Run {
+                grading,
+                targets,
+                feasible: feasible.clone(),
+                voxel,
+                resolution,
+                options: opts,
+                calibrated: calibrated.converged && other.as_ref().is_none_or(|o| o.converged),
+                timings: Timings {
+                    calibrate: calibrate_seconds,
+                    ..Timings::default()
+                },
+                warnings: warnings.clone(),
+                start,
+            };
+            let hold_back = self.auto_resolution && raises < MAX_RAISES;
+            let done = match (&self.blend, &other) {
+                (Some(blend), Some(other)) => {
+                    let margin = (crate::mesh::pipeline::HALF_WIDTH + 2.0) * voxel;
+                    let kind =
+                        BlendMapped::new(lattice, blend, margin, (lo, hi), &calibrated, other);
+                    run.try_in_box(&kind, bounds, cell, hold_back, progress, sink)?
+                }
+                _ => {
+                    let kind = Mapped {
+                        lattice,
+                        map: calibrated.map.clone(),
+                    };
+                    run.try_in_box(&kind, bounds, cell, hold_back, progress, sink)?
+                }
+            };
+            if let Some(done) = done {
+                break (done, calibrated, voxel);
             }
-            _ => {
-                let kind = Mapped {
-                    lattice,
-                    map: calibrated.map.clone(),
-                };
-                run.in_box(&kind, bounds, cell, progress, sink)?
-            }
+            let raised = (resolution as f64 * RAISE).ceil() as u32;
+            warnings.push(format!(
+                "cells missed the field at {resolution} voxels per cell: the resolution was raised to {raised} (finer voxels keep thin members from breaking loose and follow the field more closely)"
+            ));
+            resolution = raised;
+            raises += 1;
         };
         Ok(TpmsReport {
             surface: s,

@@ -77,7 +77,9 @@ pub struct Outcome {
 }
 
 /// Meshes the graded part of `kind` over `bounds` to density `target`, corrects its cells (see
-/// the module's notes) and writes the best meshing to `sink`.
+/// the module's notes) and writes the best meshing to `sink` — unless `hold_back` and even the
+/// best meshing misses a promised cell: then nothing is written and `None` returned (finer
+/// voxels may meet it).
 #[allow(clippy::too_many_arguments)]
 pub fn mesh<G: Graded>(
     kind: &G,
@@ -86,9 +88,10 @@ pub fn mesh<G: Graded>(
     cells: Cells,
     voxel: f64,
     opts: &Options,
+    hold_back: bool,
     progress: &Progress,
     sink: &mut dyn MeshSink,
-) -> Result<Outcome> {
+) -> Result<Option<Outcome>> {
     let Cells {
         grid,
         promised,
@@ -106,8 +109,9 @@ pub fn mesh<G: Graded>(
     };
     let mut levels = build(&shift);
     let mut brackets = vec![Bracket::default(); promised.len()];
-    // The worst cell's miss, the meshing and the shifts it was made with.
-    let mut best: Option<(f64, pipeline::Measured, Vec<f64>)> = None;
+    // The worst cell's miss, whether a cell missed its promise, the meshing and the shifts it
+    // was made with.
+    let mut best: Option<(f64, bool, pipeline::Measured, Vec<f64>)> = None;
     let mut meshings = 0u32;
     let mut tried = Vec::new();
     let mut search_meshing = MeshingStats::default();
@@ -156,13 +160,18 @@ pub fn mesh<G: Graded>(
             .filter(|&i| promised[i])
             .map(|i| (measured[i] - targets[i]).abs())
             .fold(0.0, f64::max);
+        let missed = (0..promised.len())
+            .any(|i| promised[i] && (measured[i] - targets[i]).abs() > tolerances[i]);
         let done = worst <= AIM || meshings >= MAX_MESHINGS;
         // The meshing whose worst cell is closest is written.
         if best.as_ref().is_none_or(|b| worst < b.0) {
-            best = Some((worst, m, shift.clone()));
+            best = Some((worst, missed, m, shift.clone()));
         }
         if done {
-            let (_, m, best_shift) = best.take().expect("a meshing was kept");
+            let (_, missed, m, best_shift) = best.take().expect("a meshing was kept");
+            if missed && hold_back {
+                return Ok(None);
+            }
             if best_shift != shift {
                 // Tiles are meshed again as they are written: at the best meshing's levels.
                 levels = build(&best_shift);
@@ -205,7 +214,7 @@ pub fn mesh<G: Graded>(
     let cells_met = checked
         .into_iter()
         .all(|c| (c.density - c.target).abs() <= c.tolerance);
-    Ok(Outcome {
+    Ok(Some(Outcome {
         written,
         route,
         level_search,
@@ -215,7 +224,7 @@ pub fn mesh<G: Graded>(
         max_cell_error,
         cells_met,
         mean_level: levels.mean,
-    })
+    }))
 }
 
 /// Whether `f` is constant over the box (on a 3×3×3 set of points).

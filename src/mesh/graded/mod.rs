@@ -362,16 +362,31 @@ impl Run<'_> {
         progress: &Progress,
         sink: &mut dyn MeshSink,
     ) -> Result<Finished> {
+        self.try_in_box(kind, bounds, cell, false, progress, sink)
+            .map(|f| f.expect("written when not held back"))
+    }
+
+    /// [`Run::in_box`]; with `hold_back`, nothing is written and `None` returned when even the
+    /// best meshing misses a promised cell (finer voxels may meet it).
+    pub fn try_in_box<G: Graded>(
+        self,
+        kind: &G,
+        bounds: Aabb,
+        cell: Vec3,
+        hold_back: bool,
+        progress: &Progress,
+        sink: &mut dyn MeshSink,
+    ) -> Result<Option<Finished>> {
         let grid = CellVolumes::new(bounds, cell);
         let (grading, feasible) = (self.grading, self.feasible.clone());
         let target = move |p: Vec3| grading.target(p, 0.0, &feasible);
         let cells = Cells::new(grid.clone(), &target, |c| grid.is_whole(c));
-        self.over(kind, &target, bounds, cells, progress, sink)
+        self.try_over(kind, &target, bounds, cells, hold_back, progress, sink)
     }
 
     /// A part in `bounds` at density `target`, `cells` promised theirs.
     pub fn over<G: Graded>(
-        mut self,
+        self,
         kind: &G,
         target: &(dyn Fn(Vec3) -> f64 + Sync),
         bounds: Aabb,
@@ -379,23 +394,43 @@ impl Run<'_> {
         progress: &Progress,
         sink: &mut dyn MeshSink,
     ) -> Result<Finished> {
+        self.try_over(kind, target, bounds, cells, false, progress, sink)
+            .map(|f| f.expect("written when not held back"))
+    }
+
+    /// [`Run::over`], holding back a part that misses a promised cell when `hold_back`.
+    #[allow(clippy::too_many_arguments)]
+    fn try_over<G: Graded>(
+        mut self,
+        kind: &G,
+        target: &(dyn Fn(Vec3) -> f64 + Sync),
+        bounds: Aabb,
+        cells: Cells,
+        hold_back: bool,
+        progress: &Progress,
+        sink: &mut dyn MeshSink,
+    ) -> Result<Option<Finished>> {
         if !self.calibrated {
             self.warnings.push(format!(
                 "the unit cell could not be calibrated at every density on {} voxels per cell: finer voxels (--resolution) meet the field more closely",
                 self.resolution
             ));
         }
-        let outcome = mesh(
+        let Some(outcome) = mesh(
             kind,
             target,
             &bounds,
             cells,
             self.voxel,
             &self.options,
+            hold_back,
             progress,
             sink,
-        )?;
-        Ok(outcome.finish(
+        )?
+        else {
+            return Ok(None);
+        };
+        Ok(Some(outcome.finish(
             self.grading,
             &self.targets,
             &self.feasible,
@@ -403,7 +438,7 @@ impl Run<'_> {
             self.timings,
             self.warnings,
             self.start,
-        ))
+        )))
     }
 }
 
