@@ -20,12 +20,28 @@ struct Measured {
 }
 
 fn measure(stl: &Path, origin: [f64; 3], cell: [f64; 3], size: [f64; 3]) -> Measured {
+    measure_cut(stl, origin, cell, size, None)
+}
+
+/// [`measure`], the cells' faces along z given (cells whose size varies along z).
+fn measure_cut(
+    stl: &Path,
+    origin: [f64; 3],
+    cell: [f64; 3],
+    size: [f64; 3],
+    faces_z: Option<&[f64]>,
+) -> Measured {
     let s = |v: [f64; 3]| v.map(|x| x.to_string()).join(",");
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checkers/cell_density.py");
+    let given = faces_z.map(|f| {
+        let list: Vec<String> = f.iter().map(|z| z.to_string()).collect();
+        format!("z:{}", list.join(","))
+    });
     let o = std::process::Command::new("python3")
         .arg(script)
         .arg(stl)
         .args([s(origin), s(cell), s(size)])
+        .args(given)
         .output()
         .expect("python3 with manifold3d and trimesh (scripts/install-deps.sh installs them)");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -1271,6 +1287,24 @@ fn bad_cell_maps_are_refused() {
     refused(dir.path(), &["tpms", "-r", "8", "-o", "x.stl"], &cases);
 }
 
+/// The 3×3×6 cells of the 15×15×30 mm block at (1, −2, 0.5) in `stl`, cut at `faces` along z
+/// (manifold3d): one piece, every cell within ±0.005 of 0.3.
+fn assert_block_cells_hold(stl: &Path, faces: &[f64]) {
+    let m = measure_cut(
+        stl,
+        [1.0, -2.0, 0.5],
+        [5.0; 3],
+        [15.0, 15.0, 30.0],
+        Some(faces),
+    );
+    assert_eq!(m.status, "Error.NoError");
+    assert_eq!(m.components, 1);
+    assert_eq!(m.cells.len(), 3 * 3 * 6);
+    for (c, f) in &m.cells {
+        assert!((f - 0.3).abs() <= 0.005, "cell {c:?} holds {f:.4}");
+    }
+}
+
 /// Cells growing along z from 3 to 8 mm through a 30 mm block (scaled so whole cells span it):
 /// closed and clean by CGAL, one piece by manifold3d, every cell (cut at the faces the report
 /// gives, each checked here to be one more cell of the test's own integral of 1/s) within
@@ -1329,31 +1363,7 @@ fn cells_growing_along_an_axis_are_whole_and_hold_the_density() {
             "face {i} at {f}: {cells} cells"
         );
     }
-    let given = format!(
-        "z:{}",
-        faces
-            .iter()
-            .map(|f| f.to_string())
-            .collect::<Vec<_>>()
-            .join(",")
-    );
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checkers/cell_density.py");
-    let o = std::process::Command::new("python3")
-        .arg(script)
-        .arg(dir.path().join("g.stl"))
-        .args(["1,-2,0.5", "5,5,5", "15,15,30", &given])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    assert_eq!(m["status"], "Error.NoError");
-    assert_eq!(m["components"], 1);
-    let cells = m["cells"].as_array().unwrap();
-    assert_eq!(cells.len(), 3 * 3 * 6);
-    for c in cells {
-        let f = c[3].as_f64().unwrap();
-        assert!((f - 0.3).abs() <= 0.005, "cell {c} holds {f:.4}");
-    }
+    assert_block_cells_hold(&dir.path().join("g.stl"), &faces);
 }
 
 /// The share of each of the part's cross-sections at `heights` that the first one does not
@@ -1438,31 +1448,7 @@ fn cells_sized_by_a_field_along_an_axis_are_whole_and_hold_the_density() {
             );
         }
     }
-    let given = format!(
-        "z:{}",
-        faces
-            .iter()
-            .map(|f| f.to_string())
-            .collect::<Vec<_>>()
-            .join(",")
-    );
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checkers/cell_density.py");
-    let o = std::process::Command::new("python3")
-        .arg(script)
-        .arg(&stl)
-        .args(["1,-2,0.5", "5,5,5", "15,15,30", &given])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    assert_eq!(m["status"], "Error.NoError");
-    assert_eq!(m["components"], 1);
-    let cells = m["cells"].as_array().unwrap();
-    assert_eq!(cells.len(), 3 * 3 * 6);
-    for c in cells {
-        let f = c[3].as_f64().unwrap();
-        assert!((f - 0.3).abs() <= 0.005, "cell {c} holds {f:.4}");
-    }
+    assert_block_cells_hold(&stl, &faces);
 }
 
 /// Cells sized by a field that varies across the box (small at its axis, large at its sides)

@@ -42,7 +42,6 @@ pub struct SizedCells {
 }
 
 /// The tabulated map and what was measured on it.
-#[derive(Debug)]
 struct Tables {
     bounds: Aabb,
     /// How the field was given.
@@ -57,6 +56,18 @@ struct Tables {
     /// The thinnest cell between two faces (`1/|∇u_a|`), mm.
     shortest: f64,
     fit: Fit,
+}
+
+/// The tables' size, not their values.
+impl std::fmt::Debug for Tables {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Tables")
+            .field("bounds", &self.bounds)
+            .field("source", &self.source)
+            .field("counts", &self.counts)
+            .field("fit", &self.fit)
+            .finish_non_exhaustive()
+    }
 }
 
 /// How the cells came from the field.
