@@ -57,14 +57,13 @@ fn main() {
     // OpenVDB: one bridge, one translation unit per operation.
     let mut vdb = cxx_build::bridge("src/ffi/vdb.rs");
     flags(&mut vdb);
-    vdb.files(VDB_UNITS).compile("latvox_vdb");
+    vdb.files(VDB_UNITS);
 
     // CGAL: one bridge; the checks here, the repair steps below with settings of their own.
     let mut cgal = cxx_build::bridge("src/ffi/cgal.rs");
     flags(&mut cgal);
     cgal.define("CGAL_LINKED_WITH_TBB", None)
-        .file(CGAL_CHECK_UNIT)
-        .compile("latvox_cgal");
+        .file(CGAL_CHECK_UNIT);
 
     // CGAL's own precondition checks are compiled out here: in the self-intersection search they
     // cost over a quarter of its CPU time (a whole-mesh triangle test on every call, degeneracy
@@ -77,8 +76,7 @@ fn main() {
         .define("CGAL_LINKED_WITH_TBB", None)
         .define("CGAL_EIGEN3_ENABLED", None)
         .define("CGAL_NDEBUG", None)
-        .file(CGAL_REPAIR_UNIT)
-        .compile("latvox_cgal_repair");
+        .file(CGAL_REPAIR_UNIT);
 
     // Corefinement (booleans), with CGAL's checks on: its inputs are checked here at run time
     // and a failed check is a reason to fall back, not a crash.
@@ -89,14 +87,36 @@ fn main() {
         // self-intersection callbacks, hundreds of lines per build: noise, not a finding.
         .flag_if_supported("-Wno-maybe-uninitialized")
         .define("CGAL_LINKED_WITH_TBB", None)
-        .file(CGAL_BOOLEAN_UNIT)
-        .compile("latvox_cgal_boolean");
+        .file(CGAL_BOOLEAN_UNIT);
     let mut cgal_distance = cxx_build::bridges(std::iter::empty::<&str>());
     flags(&mut cgal_distance);
     cgal_distance
         .define("CGAL_LINKED_WITH_TBB", None)
-        .file(CGAL_DISTANCE_UNIT)
-        .compile("latvox_cgal_distance");
+        .file(CGAL_DISTANCE_UNIT);
+
+    // The libraries compile side by side (and, with cc's `parallel`, the units of each): the
+    // CGAL units take most of the build, and one at a time they leave the other cores idle.
+    let libs = [
+        (vdb, "latvox_vdb"),
+        (cgal, "latvox_cgal"),
+        (cgal_repair, "latvox_cgal_repair"),
+        (cgal_boolean, "latvox_cgal_boolean"),
+        (cgal_distance, "latvox_cgal_distance"),
+    ];
+    std::thread::scope(|s| {
+        for (build, name) in &libs {
+            s.spawn(move || build.clone().cargo_metadata(false).compile(name));
+        }
+    });
+    // Linked in this order (a bridge before the units it calls), whichever finished first.
+    println!(
+        "cargo:rustc-link-search=native={}",
+        std::env::var("OUT_DIR").expect("cargo sets OUT_DIR")
+    );
+    for (_, name) in &libs {
+        println!("cargo:rustc-link-lib=static={name}");
+    }
+    println!("cargo:rustc-link-lib=stdc++");
 
     for lib in ["openvdb", "tbb", "Imath-3_1", "gmp", "mpfr"] {
         println!("cargo:rustc-link-lib={lib}");

@@ -18,7 +18,7 @@
 //! Run: `cargo bench --bench fgm -- --runs 1 --points 1000000 --voxels 0.4,0.2,0.1 --layer 0.27
 //! [--peer 0.4,0.2]`.
 
-#[path = "../tests/common/child.rs"]
+#[path = "../tests/it/common/child.rs"]
 mod child;
 mod support;
 

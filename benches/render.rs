@@ -9,9 +9,9 @@
 //!
 //! Run: `cargo bench --bench render -- --runs 5`.
 
-#[path = "../tests/common/child.rs"]
+#[path = "../tests/it/common/child.rs"]
 mod child;
-#[path = "../tests/meshkit/mod.rs"]
+#[path = "../tests/it/meshkit.rs"]
 mod meshkit;
 mod support;
 

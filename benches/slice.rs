@@ -17,7 +17,7 @@
 //! Run: `cargo bench --bench slice -- --runs 3` (`--quick` skips the 9.5 M-triangle part;
 //! `--implicit` runs only the part-file case).
 
-#[path = "../tests/common/child.rs"]
+#[path = "../tests/it/common/child.rs"]
 mod child;
 mod support;
 

@@ -13,7 +13,7 @@ use std::path::Path;
 use std::process::Command;
 use std::time::Instant;
 
-#[path = "../tests/common/child.rs"]
+#[path = "../tests/it/common/child.rs"]
 mod child;
 
 /// (wall seconds, peak RSS in MB, exit code) of one run of `cmd`.

@@ -17,7 +17,7 @@
 use std::path::Path;
 use std::process::Command;
 
-#[path = "../tests/common/child.rs"]
+#[path = "../tests/it/common/child.rs"]
 mod child;
 
 /// (wall seconds, peak RSS in MB, exit code) of one run of `cmd`.

@@ -10,7 +10,7 @@
 //!
 //! Run: `cargo bench --bench view -- --runs 3 --frames 5 [--gpu]`.
 
-#[path = "../tests/meshkit/mod.rs"]
+#[path = "../tests/it/meshkit.rs"]
 mod meshkit;
 mod support;
 

@@ -3,8 +3,7 @@
 //! reader (edges, divergence volume), the input array itself (thresholded volume), OpenCASCADE
 //! through gmsh reading the IGES, and ezdxf reading the DXF.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

@@ -3,8 +3,8 @@
 //! shared corners, and the simple cubic lattice's volume in closed form), refusals checked for
 //! one line, exit code 2 and no file, and a seeded property test over random settings.
 
-mod common;
-use common::*;
+use crate::common;
+use crate::common::*;
 use std::f64::consts::PI;
 use std::path::Path;
 

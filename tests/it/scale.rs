@@ -4,8 +4,8 @@
 //! matches its triangle count, and its enclosed volume (divergence theorem) is the reported one
 //! and the requested density.
 
-mod common;
-use common::*;
+use crate::common;
+use crate::common::*;
 use std::io::Read;
 
 /// Runs latvox with `args` in `dir`; returns (exit code, peak RSS in bytes) from wait4.

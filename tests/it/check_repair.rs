@@ -2,11 +2,10 @@
 //! libcgal-demo, admesh's example block) and on defects made here, with every count compared to
 //! an independent computation: trimesh (PyPI), admesh, and brute force in `meshkit`.
 
-mod common;
-mod meshkit;
+use crate::{common, meshkit};
 
-use common::{run, tempdir};
-use meshkit::*;
+use crate::common::{run, tempdir};
+use crate::meshkit::*;
 use serde_json::Value;
 use std::path::Path;
 

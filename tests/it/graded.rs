@@ -4,9 +4,8 @@
 //! here from the field's own formula; the part closed and in one piece by manifold3d and by
 //! CGAL's checks in the report.
 
-mod common;
-mod meshkit;
-use common::*;
+use crate::common::*;
+use crate::meshkit;
 use std::path::Path;
 
 /// What manifold3d measured on a mesh.

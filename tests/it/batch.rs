@@ -4,9 +4,8 @@
 //! `tpms` ones, a batch killed with SIGKILL and resumed, shards whose union is the whole batch,
 //! failures reported and retried.
 
-mod common;
-mod meshkit;
-use common::*;
+use crate::common::*;
+use crate::meshkit;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::process::Stdio;

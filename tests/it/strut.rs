@@ -4,9 +4,9 @@
 //! job, written, and measured here with the tests' own code (volume by the divergence theorem,
 //! edges by hash map, pieces by shared corners); CGAL's checks from the job's report.
 
-mod common;
+use crate::common;
 
-use common::*;
+use crate::common::*;
 use latvox::field::{Aabb, Domain};
 use latvox::io::sink::MeshCollector;
 use latvox::mesh::pipeline::Options;

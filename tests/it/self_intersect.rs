@@ -4,17 +4,16 @@
 //! cases abound), and the fan checks give CGAL's closedness, manifoldness, orientation and
 //! volume.
 
-mod common;
-mod meshkit;
+use crate::meshkit;
 
-use common::{tempdir, Rng};
+use crate::common::{tempdir, Rng};
+use crate::meshkit::{cgal_data, cuboid, write_stl, Tri};
 use latvox::check::cgal;
 use latvox::check::self_intersect::{cgal_soup_self_intersections, soup_self_intersections};
 use latvox::check::verify::{topology, verify, Verify};
 use latvox::mesh::Mesh;
 use latvox::progress::Progress;
 use latvox::tpms::{Domain, Structure, Surface, TpmsJob};
-use meshkit::{cgal_data, cuboid, write_stl, Tri};
 
 /// Both searches over every facet with three distinct vertices: same count, same pairs.
 fn same_pairs_as_cgal(mesh: &Mesh, what: &str) -> u64 {

@@ -4,8 +4,7 @@
 //! (through `latvox check`) finds the copied part closed, manifold, outward and free of
 //! self-intersections — on the whole written part, not only on the template.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn tpms(dir: &std::path::Path, ty: &str, st: &str, out: &str, extra: &[&str]) -> serde_json::Value {
     let report = format!("{out}.json");

@@ -5,10 +5,9 @@
 //! back by this test's own STL reader: volume by the divergence theorem, edges by hash map,
 //! pieces by shared corners; CGAL's verdict comes from the report.
 
-mod common;
-mod meshkit;
-use common::*;
-use meshkit::{torus as torus_tris, write_stl};
+use crate::common::*;
+use crate::meshkit::{torus as torus_tris, write_stl};
+use crate::{common, meshkit};
 use std::f64::consts::PI;
 use std::path::Path;
 

@@ -2,8 +2,7 @@
 //! once — the same triangles, bit for bit (compared here as sorted records read from the two
 //! files), so the same volume; both closed and manifold by an edge count independent of latvox.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// The triangles of a binary STL as sorted byte records (corners only, normals dropped).
 fn records(path: &std::path::Path) -> Vec<[u8; 36]> {

@@ -4,8 +4,7 @@
 //! are checked again without latvox: each job made once, by the array task of its shard, into a
 //! closed part at its density.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::Command;

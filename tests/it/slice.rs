@@ -7,10 +7,9 @@
 //! bad input refused. A randomised property test slices random placements of test solids along
 //! random directions and compares every section with Green's theorem over the facets.
 
-mod common;
-mod meshkit;
-use common::*;
-use meshkit::Tri;
+use crate::common::*;
+use crate::meshkit;
+use crate::meshkit::Tri;
 use std::f64::consts::PI;
 use std::path::Path;
 

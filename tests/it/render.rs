@@ -4,9 +4,8 @@
 //! against dense ray marching on random rays through thin struts and sheets (no tunnelling),
 //! and bad input is refused.
 
-mod common;
-mod meshkit;
-use common::*;
+use crate::common::*;
+use crate::meshkit;
 use latvox::render::camera::Ray;
 use latvox::render::trace::{Implicit, Tolerance};
 use latvox::render::{Model, Periodic};

@@ -1,8 +1,7 @@
 //! The `latvox tpms` and `latvox check` commands, run as a user runs them, checked with
 //! computations independent of latvox (see `common`) and with CGAL's verdict from the report.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 const TYPES: [&str; 9] = [
     "p", "gyroid", "d", "iwp", "s", "frd", "neovius", "lidinoid", "split-p",

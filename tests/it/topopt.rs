@@ -2,8 +2,7 @@
 //! (`tests/reference/top88.py`, `tests/reference/top3d.py`): the same compliance history — first
 //! iteration to 1e-4 relative, converged value to 0.5 % — and the same densities.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::Path;
 use std::process::Command;
 

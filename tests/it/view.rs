@@ -5,9 +5,8 @@
 //! HTTP: bad requests get 4xx answers and the server goes on; meshing and slicing from it make
 //! the files the commands make.
 
-mod common;
-mod meshkit;
-use common::*;
+use crate::common::*;
+use crate::meshkit;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
 use std::path::Path;

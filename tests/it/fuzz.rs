@@ -8,7 +8,7 @@
 //! - `check` and `repair`, CGAL and OpenVDB behind them: the `check_repair` target
 //!   (`fuzz/cgal`) replayed on its corpus and random mutations of it, built with this crate.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::process::Command;
@@ -111,7 +111,7 @@ fn every_reader_survives_fuzzing() {
     );
 }
 
-#[path = "../fuzz/cgal/src/lib.rs"]
+#[path = "../../fuzz/cgal/src/lib.rs"]
 mod check_repair;
 
 /// How long the replay of the check-and-repair corpus goes on mutating it, seconds.

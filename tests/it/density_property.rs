@@ -12,8 +12,7 @@
 //! fast cases run in `cargo test`; `cargo test --release --test density_property -- --ignored`
 //! runs a thousand over the whole feasible range.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::Path;
 
 /// Where each type and structure holds together (the solid's feasible range, as latvox's

@@ -4,9 +4,7 @@
 //! solids — the analytic volume of a ball-and-beam lattice, and manifold3d's union of the
 //! same frustums, caps and spheres (polygons of 256 sides) for everything else.
 
-mod common;
-
-use common::{json, python, run, tempdir};
+use crate::common::{json, python, run, tempdir};
 use serde_json::{json, Value};
 use std::f64::consts::PI;
 use std::io::Write;

@@ -2,9 +2,9 @@
 //! shapes and independent readers — OpenVDB's Python module and `vdb_print` for the grids, the
 //! analytic distance for the PNG stack's layers.
 
-mod common;
+use crate::common;
 
-use common::{assert_refusal, files_in, json, ok, run, tempdir, Rng};
+use crate::common::{assert_refusal, files_in, json, ok, run, tempdir, Rng};
 use latvox::fgm::material::{Composition, Feature, Features, Law};
 use latvox::fgm::{FgmJob, Geometry, Sign};
 use latvox::io::points::PointCloud;

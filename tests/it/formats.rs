@@ -4,11 +4,8 @@
 //! module as a level set of the part's voxels enclosing the reported volume (voids kept: a
 //! filled part with a skin encloses some).
 
-mod common;
-mod meshkit;
-
-use common::*;
-use meshkit::{cuboid, write_stl};
+use crate::common::*;
+use crate::meshkit::{cuboid, write_stl};
 use serde_json::Value;
 use std::path::Path;
 

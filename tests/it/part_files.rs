@@ -2,8 +2,7 @@
 //! same part, byte for byte; options on the command line override the file's; a batch job can
 //! name one; bad part files are refused in one line with no file written.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::Path;
 
 fn ok(out: &std::process::Output) {

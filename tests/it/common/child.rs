@@ -1,6 +1,6 @@
 //! A child process measured as the kernel counts it: wall time, exit code and peak resident
 //! memory (`ru_maxrss` from `wait4`). Shared by the tests and the benchmarks
-//! (`#[path = "../tests/common/child.rs"]`).
+//! (`#[path = "../tests/it/common/child.rs"]`).
 
 use std::process::Command;
 use std::time::Instant;
