@@ -522,12 +522,13 @@ fn bad_input_is_refused() {
     }
 }
 
-/// README's pictures are what `latvox render` makes of the part files beside them, run from
-/// another folder (a part file names its mesh relative to itself): the same picture at ≥ 99 %
-/// of pixels (within 8 levels per channel).
+/// README's pictures (docs/src/images) are what `latvox render` makes of the part files in
+/// docs/examples, run from another folder (a part file names its mesh relative to itself): the
+/// same picture at ≥ 99 % of pixels (within 8 levels per channel).
 #[test]
 fn readme_pictures_are_what_render_makes() {
     let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs");
+    let (examples, images) = (docs.join("examples"), docs.join("src/images"));
     let dir = tempdir();
     let d = dir.path();
     let size = ["--width", "400", "--height", "300"];
@@ -540,14 +541,14 @@ fn readme_pictures_are_what_render_makes() {
         ),
     ];
     for (name, extra) in cases {
-        let part = docs.join(format!("{name}.toml"));
+        let part = examples.join(format!("{name}.toml"));
         let part = part.to_str().unwrap();
         let mut args = vec!["render", part, "-o", "new.png"];
         args.extend_from_slice(&size);
         args.extend_from_slice(extra);
         ok(&args, d);
         let (w, h, new) = read_png(&d.join("new.png"));
-        let (w0, h0, old) = read_png(&docs.join(format!("{name}.png")));
+        let (w0, h0, old) = read_png(&images.join(format!("{name}.png")));
         assert_eq!((w, h), (w0, h0));
         let same = new
             .chunks(3)
