@@ -1,29 +1,59 @@
 #!/usr/bin/env bash
-# Installs the Debian packages latvox builds against and the tools its tests check with.
-# Idempotent: packages already present are not fetched again. Works as root, or through sudo.
+# Installs what latvox needs, in two tiers:
+#
+#   scripts/install-deps.sh          building and running latvox: the compiler and the
+#                                    development packages of OpenVDB, CGAL and what they link
+#   scripts/install-deps.sh --tests  that, and what the tests check with: independent checkers
+#                                    (admesh, OpenVDB's tools and Python module, trimesh,
+#                                    manifold3d, lib3mf, shapely, gmsh, ezdxf, SciPy, libigl),
+#                                    CGAL's and the slicers' meshes, headless Chromium with
+#                                    Playwright, a one-node Slurm cluster (slurm-wlm, munge), the
+#                                    nightly toolchain with cargo-fuzz, and mdBook for the book
+#
+# Debian bookworm. Idempotent: what is present is not fetched again. Works as root, or through
+# sudo.
 set -euo pipefail
 
-PKGS=(
-  # build: the C++ libraries behind the bridge
-  g++ pkg-config libopenvdb-dev libcgal-dev libtbb-dev libgmp-dev libmpfr-dev libeigen3-dev
-  libimath-dev libblosc-dev zlib1g-dev libboost-dev
-  # tests: independent checkers
-  admesh libopenvdb-tools
-  # fgm tests: OpenVDB's own Python module reads the .vdb grids back
-  python3-openvdb
-  # tests (topo): Python for the published optimisers' reference transcriptions, and the
-  # libraries the PyPI gmsh wheel (OpenCASCADE, reads IGES back) links against
-  python3 python3-pip python3-venv libglu1-mesa libgl1 libopengl0 libxrender1 libxcursor1
-  libxfixes3 libxext6 libxft2 libfontconfig1 libxinerama1 libx11-6 libgomp1
-  # tests: a one-node Slurm cluster for latvox batch (scripts/slurm-test.sh)
-  slurm-wlm munge
-  # mesh check/repair tests: CGAL's data archive of broken meshes; pip for trimesh
-  libcgal-demo python3-pip
-  # browser editor tests (latvox view): headless Chromium, driven through Playwright
-  chromium
-)
+TESTS=0
+for arg in "$@"; do
+  case "$arg" in
+    --tests) TESTS=1 ;;
+    -h | --help)
+      sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'
+      exit 0
+      ;;
+    *)
+      echo "install-deps: unknown option '$arg' (--tests adds the test tier)" >&2
+      exit 2
+      ;;
+  esac
+done
 
 if [ "$(id -u)" -eq 0 ]; then SUDO=(); else SUDO=(sudo); fi
+
+# Building and running: the C++ libraries behind the bridge.
+PKGS=(
+  g++ pkg-config libopenvdb-dev libcgal-dev libtbb-dev libgmp-dev libmpfr-dev libeigen3-dev
+  libimath-dev libblosc-dev zlib1g-dev libboost-dev
+)
+if [ "$TESTS" -eq 1 ]; then
+  PKGS+=(
+    # independent checkers
+    admesh libopenvdb-tools
+    # fgm tests: OpenVDB's own Python module reads the .vdb grids back
+    python3-openvdb
+    # Python for the reference optimisers and checkers, and the libraries the PyPI gmsh wheel
+    # (OpenCASCADE, reads IGES back) links against
+    python3 python3-pip python3-venv libglu1-mesa libgl1 libopengl0 libxrender1 libxcursor1
+    libxfixes3 libxext6 libxft2 libfontconfig1 libxinerama1 libx11-6 libgomp1
+    # batch tests: a one-node Slurm cluster (scripts/slurm-test.sh)
+    slurm-wlm munge
+    # check/repair tests: CGAL's data archive of broken meshes
+    libcgal-demo
+    # browser editor tests (latvox view): headless Chromium, driven through Playwright
+    chromium
+  )
+fi
 
 missing=()
 for p in "${PKGS[@]}"; do
@@ -36,16 +66,18 @@ if [ ${#missing[@]} -gt 0 ]; then
   "${SUDO[@]}" apt-get update -qq
   "${SUDO[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 else
-  echo "install-deps: all packages present" >&2
+  echo "install-deps: Debian packages present" >&2
 fi
+
+[ "$TESTS" -eq 1 ] || exit 0
 
 # Python packages for the tests: NumPy/SciPy (reference optimisers, independent checks of the
 # cleaned fields), gmsh (OpenCASCADE reads the IGES back), ezdxf (reads the DXF back),
-# trimesh with networkx and lxml (an independent mesh analyser for check/repair), shapely
-# (checks every slice layer's polygons), Playwright (drives Debian's Chromium through the
-# browser editor's page; it uses that browser and downloads none of its own), libigl (the
-# peer of the FGM benchmark: its fast winding numbers for point clouds), and manifold3d (cuts a
-# graded part at its cells' faces to measure each cell's density).
+# trimesh with networkx and lxml (an independent mesh analyser for check/repair), lib3mf (reads
+# 3MF back), shapely (checks every slice layer's polygons), Playwright (drives Debian's Chromium
+# through the browser editor's page; it uses that browser and downloads none of its own), libigl
+# (the peer of the FGM benchmark: its fast winding numbers for point clouds), and manifold3d
+# (cuts a graded part at its cells' faces to measure each cell's density).
 PY_PKGS=(numpy scipy gmsh ezdxf trimesh networkx lxml lib3mf shapely playwright libigl manifold3d)
 PY_IMPORTS="import numpy, scipy, gmsh, ezdxf, trimesh, networkx, lxml, lib3mf, shapely, playwright, igl, manifold3d"
 if python3 -c "$PY_IMPORTS" 2>/dev/null; then
@@ -61,14 +93,22 @@ else
   python3 -c "$PY_IMPORTS"
 fi
 
-# Fuzzing the mesh readers inside `cargo test`: cargo-fuzz on a nightly toolchain.
+CARGO_BIN="${CARGO_HOME:-$HOME/.cargo}/bin"
+
+# The fuzz campaign of the long tier: cargo-fuzz on a nightly toolchain.
 if command -v rustup >/dev/null 2>&1 && ! rustup toolchain list | grep -q '^nightly'; then
   echo "install-deps: installing the nightly Rust toolchain (for cargo fuzz)" >&2
   rustup toolchain install nightly --profile minimal
 fi
-if ! command -v cargo-fuzz >/dev/null 2>&1 && [ ! -x "${CARGO_HOME:-$HOME/.cargo}/bin/cargo-fuzz" ]; then
+if ! command -v cargo-fuzz >/dev/null 2>&1 && [ ! -x "$CARGO_BIN/cargo-fuzz" ]; then
   echo "install-deps: installing cargo-fuzz" >&2
   cargo install --locked cargo-fuzz
+fi
+
+# The book (docs/): mdBook, without its live-reload server.
+if ! command -v mdbook >/dev/null 2>&1 && [ ! -x "$CARGO_BIN/mdbook" ]; then
+  echo "install-deps: installing mdbook" >&2
+  cargo install --locked mdbook --no-default-features --features search
 fi
 
 # check/repair tests: real meshes shipped with Debian's slicers (printer beds, platforms, test

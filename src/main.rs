@@ -2,7 +2,7 @@
 //! Exit codes: 0 success, 1 a check found defects, 2 bad input or arguments, 3 a backend failed
 //! unexpectedly (a bug to report).
 
-use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser};
 use latvox::Error;
 
 mod cli;
@@ -20,7 +20,9 @@ Exit codes (every command):
     version,
     about = "Sparse-volume voxel engine for additive manufacturing: TPMS and strut lattices and lattice-filled parts at exact density, verified closed and free of self-intersections",
     long_about = None,
-    after_help = EXIT_CODES
+    after_help = EXIT_CODES,
+    subcommand_required = true,
+    arg_required_else_help = true
 )]
 struct Cli {
     /// Worker threads for latvox and OpenVDB/TBB (default: all cores).
@@ -29,62 +31,17 @@ struct Cli {
     /// No progress display.
     #[arg(long, short, global = true)]
     quiet: bool,
-    #[command(subcommand)]
-    command: Command,
 }
 
-#[derive(Subcommand)]
-enum Command {
-    /// Generate a closed TPMS lattice at an exact volume fraction.
-    #[command(after_help = cli::tpms::EXAMPLES)]
-    Tpms(cli::tpms::TpmsArgs),
-    /// Generate a closed strut (beam) lattice — BCC, octet, Kelvin or a cell of your own — at an
-    /// exact volume fraction or strut radius.
-    #[command(after_help = cli::strut::EXAMPLES)]
-    Strut(cli::strut::StrutArgs),
-    /// Fill a part with a lattice: a solid skin of the part's shape, its core a TPMS or strut
-    /// lattice at an exact density, solids kept whole where asked.
-    #[command(after_help = cli::fill::EXAMPLES)]
-    Fill(cli::fill::FillArgs),
-    /// Check a mesh file: every defect counted (holes, non-manifold, winding, normals, degenerate
-    /// and duplicate facets, T-junctions, self-intersections), per shell too.
-    #[command(after_help = cli::check::EXAMPLES)]
-    Check(cli::check::CheckArgs),
-    /// Repair a mesh file and report every change by kind and count.
-    #[command(after_help = cli::repair::EXAMPLES)]
-    Repair(cli::repair::RepairArgs),
-    /// SIMP topology optimisation (88-line code in 2D, top3d in 3D): densities to .npy.
-    #[command(after_help = cli::topopt::EXAMPLES)]
-    Topopt(cli::topopt::TopoptArgs),
-    /// Density field to printable STL and parametric CAD (IGES, DXF): feature-preserving cleanup
-    /// and adaptive B-spline fitting (Liu et al., Engineering 2018).
-    #[command(after_help = cli::topo::EXAMPLES)]
-    Topo(cli::topo::TopoArgs),
-    /// Functionally graded material from distance fields: a scanned point cloud (or a mesh) to
-    /// a signed distance grid, material fractions graded by the distance to features, and .vdb
-    /// grids, a coloured mesh and voxel-print PNG stacks.
-    #[command(after_help = cli::fgm::EXAMPLES)]
-    Fgm(cli::fgm::FgmArgs),
-    /// Render a picture of a part file, sphere-traced from its implicit solid without meshing
-    /// it, or of a mesh file, ray cast.
-    #[command(after_help = cli::render::EXAMPLES)]
-    Render(cli::render::RenderArgs),
-    /// Edit a part file live in the browser: a local server whose page sphere-traces the part
-    /// on the GPU (no mesh), with controls, sections, saving, meshing and slicing.
-    #[command(after_help = cli::view::EXAMPLES)]
-    View(cli::view::ViewArgs),
-    /// Slice a mesh file, or a part file without meshing it, into layers for printing: CLI
-    /// (Common Layer Interface), SVG, PNG masks, SL1; uniform or adaptive layers, any build
-    /// direction.
-    #[command(after_help = cli::slice::EXAMPLES)]
-    Slice(cli::slice::SliceArgs),
-    /// Run many jobs from a TOML job file: sweeps, workers, resume after a kill, Slurm arrays.
-    #[command(after_help = cli::batch::EXAMPLES)]
-    Batch(cli::batch::BatchArgs),
+/// The whole command line: the global options and every subcommand of [`cli::COMMANDS`].
+fn command_line() -> clap::Command {
+    cli::COMMANDS
+        .iter()
+        .fold(Cli::command(), |cmd, c| cmd.subcommand(c.clap()))
 }
 
-/// The command line with a part file's options put in (`--part`, for `tpms`, `strut`, `fill` and
-/// `fgm`).
+/// The command line with a part file's options put in (`--part`, for the commands whose parts
+/// part files hold).
 fn expanded_args() -> latvox::Result<Vec<String>> {
     let argv: Vec<String> = std::env::args().collect();
     // The subcommand: the first word that is not a global option or its value.
@@ -96,8 +53,8 @@ fn expanded_args() -> latvox::Result<Vec<String>> {
             _ => break,
         }
     }
-    match argv.get(i).map(String::as_str) {
-        Some(command @ ("tpms" | "strut" | "fill" | "fgm")) => {
+    match argv.get(i).and_then(|name| cli::command::find(name)) {
+        Some(command) if command.part.is_some() => {
             let tail = cli::part::expand(command, argv[i + 1..].to_vec())?;
             Ok([&argv[..=i], &tail[..]].concat())
         }
@@ -118,7 +75,7 @@ fn main() {
         eprintln!("latvox: {}", one_line(&e));
         std::process::exit(e.exit_code());
     });
-    let parsed = Cli::command()
+    let parsed = command_line()
         .try_get_matches_from(argv)
         .and_then(|m| Cli::from_arg_matches(&m).map(|c| (c, m)));
     let (cli, matches) = match parsed {
@@ -163,40 +120,22 @@ fn main() {
             .build_global();
         latvox::grid::set_backend_threads(n);
     }
+    let (name, sub) = matches.subcommand().expect("clap requires a subcommand");
+    let command = cli::command::find(name).expect("every subcommand is in cli::COMMANDS");
     // The part file (if asked for) is written once the part is made; its folder must take it.
-    let save_part = matches.subcommand().and_then(|(name, sub)| {
-        sub.try_get_one::<std::path::PathBuf>("save_part")
-            .ok()
-            .flatten()
-            .map(|p| (name.to_string(), p.clone(), sub.clone()))
-    });
-    if let Some((_, p, _)) = &save_part {
+    let save_part = sub
+        .try_get_one::<std::path::PathBuf>("save_part")
+        .ok()
+        .flatten();
+    if let Some(p) = save_part {
         if let Err(e) = latvox::io::atomic::check_writable(p) {
             eprintln!("latvox: {}", one_line(&e));
             std::process::exit(e.exit_code());
         }
     }
-    let result = match &cli.command {
-        Command::Tpms(a) => cli::tpms::run(a, cli.quiet),
-        Command::Strut(a) => cli::strut::run(a, cli.quiet),
-        Command::Fill(a) => cli::fill::run(a, cli.quiet),
-        Command::Check(a) => cli::check::run(a, cli.quiet),
-        Command::Repair(a) => cli::repair::run(a, cli.quiet),
-        Command::Topopt(a) => cli::topopt::run(a, cli.quiet),
-        Command::Topo(a) => cli::topo::run(a, cli.quiet),
-        Command::Fgm(a) => cli::fgm::run(a, cli.quiet),
-        Command::Batch(a) => cli::batch::run(a, cli.quiet),
-        Command::Render(a) => cli::render::run(a),
-        Command::View(a) => cli::view::run(a),
-        Command::Slice(a) => cli::slice::run(a, cli.quiet),
-    };
-    let result = result.and_then(|code| {
-        if let Some((name, path, sub)) = &save_part {
-            let cmd = Cli::command();
-            let cmd = cmd
-                .find_subcommand(name)
-                .expect("the subcommand that ran is a subcommand");
-            cli::part::save(path, name, cmd, sub)?;
+    let result = (command.run)(sub, cli.quiet).and_then(|code| {
+        if let Some(path) = save_part {
+            cli::part::save(path, command, sub)?;
         }
         Ok(code)
     });

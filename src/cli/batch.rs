@@ -2,25 +2,19 @@
 //!
 //! Each job's table becomes its subcommand's long options (`cells = [4, 4, 2]` → `--cells=4,4,2`,
 //! `ascii = true` → `--ascii`, `input = "a.npy"` → the positional input) and is parsed by that
-//! subcommand's own clap `Args` — the very parser of `latvox tpms ...`, `latvox topo ...` or
+//! subcommand's own clap `Args` — the very parser of `latvox tpms ...`, `latvox interpret ...` or
 //! `latvox repair ...` — and run in-process by the same code as the subcommand. Every job
 //! is parsed before any runs, so a typo in the last job stops the batch at once, not hours in.
 //! The library ([`latvox::batch`]) does the rest: shards, resuming, workers, reports, summary.
 //!
-//! A subcommand joins the batch by implementing [`Task`] for its `Args` and adding one line to
-//! [`COMMANDS`].
+//! A subcommand joins the batch by implementing [`Task`] for its arguments and naming it in its
+//! [`Command`]'s `job`.
 
 use super::clap_message;
-use super::fgm::FgmArgs;
-use super::fill::FillArgs;
+use super::command::{find, names_with, parsed, Command};
 use super::out::outln;
-use super::repair::RepairArgs;
-use super::slice::SliceArgs;
-use super::strut::StrutArgs;
-use super::topo::TopoArgs;
-use super::tpms::TpmsArgs;
-use clap::{Args, FromArgMatches};
-use latvox::batch::{self, Event, Job, JobFile, Settings, Shard, Status, Task, TaskReport, Value};
+use clap::Args;
+use latvox::batch::{self, Event, Job, JobFile, Settings, Shard, Status, Task, Value};
 use latvox::progress::Progress;
 use latvox::{Error, Result};
 use std::path::{Path, PathBuf};
@@ -89,6 +83,15 @@ JOBS-summary.csv and .json beside the job file.
 Exit code 0 when every job is done, 1 when some failed or found defects, 2 when the job file
 or an option is wrong (nothing is run).";
 
+/// `latvox batch`.
+pub(crate) const COMMAND: Command = Command::new(
+    "batch",
+    "Run many jobs from a TOML job file: sweeps, workers, resume after a kill, Slurm arrays",
+    EXAMPLES,
+    <BatchArgs as clap::Args>::augment_args,
+    |m, quiet| run(&parsed(m)?, quiet),
+);
+
 #[derive(Args)]
 pub struct BatchArgs {
     /// Job file (TOML) with [[job]] and [[sweep]] tables.
@@ -121,131 +124,19 @@ fn parse_shard(s: &str) -> std::result::Result<Shard, String> {
     Shard::parse(s).map_err(|e| e.to_string())
 }
 
-/// How a job of a given subcommand is turned into a task.
-type ParseJob = fn(&'static str, &Job) -> std::result::Result<Box<dyn Task>, String>;
-
-/// The subcommands a job file can run: those that make a part, and slicing.
-const COMMANDS: &[(&str, ParseJob)] = &[
-    ("tpms", parse_job::<TpmsArgs>),
-    ("strut", parse_job::<StrutArgs>),
-    ("fill", parse_job::<FillArgs>),
-    ("fgm", parse_job::<FgmArgs>),
-    ("topo", parse_job::<TopoArgs>),
-    ("repair", parse_job::<RepairArgs>),
-    ("slice", parse_job::<SliceArgs>),
-];
-
-impl Task for TpmsArgs {
-    fn outputs(&self) -> Vec<PathBuf> {
-        vec![self.mesh.output.clone()]
-    }
-
-    fn run(&self) -> Result<TaskReport> {
-        let r = super::tpms::execute(self, &Progress::hidden())?;
-        TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
-    }
-}
-
-impl Task for StrutArgs {
-    fn outputs(&self) -> Vec<PathBuf> {
-        vec![self.mesh.output.clone()]
-    }
-
-    fn run(&self) -> Result<TaskReport> {
-        super::strut::execute(self, &Progress::hidden())?.task_report()
-    }
-}
-
-impl Task for FillArgs {
-    fn outputs(&self) -> Vec<PathBuf> {
-        vec![self.mesh.output.clone()]
-    }
-
-    fn run(&self) -> Result<TaskReport> {
-        let r = super::fill::execute(self, &Progress::hidden())?;
-        TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
-    }
-}
-
-impl Task for FgmArgs {
-    fn outputs(&self) -> Vec<PathBuf> {
-        super::fgm::outputs(self)
-    }
-
-    fn run(&self) -> Result<TaskReport> {
-        if self.two_d {
-            let r = super::fgm::execute_plane(self, &Progress::hidden())?;
-            return Ok(TaskReport {
-                report: serde_json::to_value(&r).map_err(|e| Error::invalid(e.to_string()))?,
-                passed: true,
-                warnings: Vec::new(),
-            });
-        }
-        let r = super::fgm::execute(self, &Progress::hidden())?;
-        let verdict = r.checks.verdict();
-        TaskReport::new(&r, &verdict, Vec::new())
-    }
-}
-
-impl Task for TopoArgs {
-    fn outputs(&self) -> Vec<PathBuf> {
-        self.files().paths()
-    }
-
-    fn run(&self) -> Result<TaskReport> {
-        let r = super::topo::execute(self, &Progress::hidden())?
-            .result
-            .report;
-        TaskReport::new(&r, &r.verdict(), r.warnings())
-    }
-}
-
-impl Task for RepairArgs {
-    fn outputs(&self) -> Vec<PathBuf> {
-        vec![self.output.clone()]
-    }
-
-    fn run(&self) -> Result<TaskReport> {
-        let r = super::repair::execute(self, &Progress::hidden())?;
-        TaskReport::new(&r, &r.verdict, Vec::new())
-    }
-}
-
-impl Task for SliceArgs {
-    fn outputs(&self) -> Vec<PathBuf> {
-        super::slice::outputs(self)
-    }
-
-    fn run(&self) -> Result<TaskReport> {
-        let r = super::slice::execute(self, false, &Progress::hidden())?;
-        Ok(TaskReport {
-            report: serde_json::to_value(&r).map_err(|e| Error::invalid(e.to_string()))?,
-            passed: r.open_chains == 0,
-            warnings: Vec::new(),
-        })
-    }
-}
-
-/// Parses `job` with the clap `Args` of its subcommand, `A`.
-fn parse_job<A>(name: &'static str, job: &Job) -> std::result::Result<Box<dyn Task>, String>
-where
-    A: Args + FromArgMatches + Task + 'static,
-{
-    let mut cmd = A::augment_args(clap::Command::new(name))
-        .no_binary_name(true)
-        .disable_help_flag(true);
-    cmd.build();
+/// Parses `job` with the clap arguments of its subcommand, `command`.
+fn parse_job(command: &Command, job: &Job) -> std::result::Result<Box<dyn Task>, String> {
+    let (Some(task), mut cmd) = (command.job, command.parser()) else {
+        return Err(format!("`latvox {}` cannot run as a job", command.name));
+    };
     let argv = command_line(&cmd, job)?;
     // A job may name a part file (`part = "octet.toml"`): its settings, the job's own first.
-    let argv = match name {
-        "tpms" | "strut" | "fill" | "fgm" => {
-            super::part::expand(name, argv).map_err(|e| e.to_string())?
-        }
-        _ => argv,
+    let argv = match command.part {
+        Some(_) => super::part::expand(command, argv).map_err(|e| e.to_string())?,
+        None => argv,
     };
     let matches = cmd.try_get_matches_from_mut(argv).map_err(clap_message)?;
-    let args = A::from_arg_matches(&matches).map_err(clap_message)?;
-    Ok(Box::new(args))
+    task(&matches).map_err(|e| e.to_string())
 }
 
 /// The job's options as the subcommand's command line: `key = v` → `--key=v` (so a value such
@@ -292,19 +183,18 @@ fn command_line(cmd: &clap::Command, job: &Job) -> std::result::Result<Vec<Strin
 
 /// clap's error as one line, keeping its "similar argument" tip.
 fn task_for(job: &Job) -> Result<Box<dyn Task>> {
-    let known = || COMMANDS.iter().map(|c| c.0).collect::<Vec<_>>().join(", ");
-    let (name, parse) = COMMANDS
-        .iter()
-        .find(|c| c.0 == job.command)
+    let command = find(&job.command)
+        .filter(|c| c.job.is_some())
         .ok_or_else(|| {
             Error::invalid(format!(
                 "{}: '{}' is not a subcommand a job can run (jobs can run: {})",
                 job.origin,
                 job.command,
-                known()
+                names_with(|c| c.job.is_some())
             ))
         })?;
-    parse(name, job).map_err(|m| Error::invalid(format!("{} ({}): {m}", job.origin, job.command)))
+    parse_job(command, job)
+        .map_err(|m| Error::invalid(format!("{} ({}): {m}", job.origin, job.command)))
 }
 
 pub fn run(a: &BatchArgs, quiet: bool) -> Result<i32> {
@@ -477,7 +367,8 @@ fn suffixed(base: &Path, suffix: &str) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clap::CommandFactory;
+    use crate::cli::tpms::TpmsArgs;
+    use clap::{CommandFactory, FromArgMatches};
 
     fn job(text: &str) -> Job {
         latvox::batch::jobfile::parse(text).unwrap().remove(0)
@@ -534,7 +425,7 @@ mod tests {
             "[[job]]\ncommand='tpms'\noutput='a.stl'\ntype='d'\nstructure='sheet'\n\
              density=0.25\ncells=[4,4,2]\ncell-size=6\norigin=[-5, 0, 2.5]\nascii=true\n",
         );
-        let t = parse_job::<TpmsArgs>("tpms", &j).unwrap();
+        let t = parse_job(&crate::cli::tpms::COMMAND, &j).unwrap();
         assert_eq!(t.outputs(), [PathBuf::from("a.stl")]);
         let mut cmd = TpmsArgs::augment_args(clap::Command::new("tpms")).no_binary_name(true);
         cmd.build();
@@ -550,7 +441,7 @@ mod tests {
         assert!(!a.allow_islands);
 
         let bad = job("[[job]]\ncommand='tpms'\noutput='a.stl'\ncell_sise=5\n");
-        let e = parse_job::<TpmsArgs>("tpms", &bad).err().unwrap();
+        let e = parse_job(&crate::cli::tpms::COMMAND, &bad).err().unwrap();
         assert!(
             e.contains("'--cell-sise'") && e.contains("'--cell-size'"),
             "{e}"

@@ -2,6 +2,7 @@
 //! verdict), as a summary or as JSON.
 
 use super::cgal_findings;
+use super::command::{parsed, Command};
 use super::out::outln;
 use clap::Args;
 use latvox::check::{check_file, CheckOptions, CheckReport, Orientation};
@@ -29,6 +30,15 @@ closedness, orientation and volume beside latvox, as a second opinion.
 
 Exit code 0 when the mesh is a valid closed, outward, self-intersection-free solid; 1 when
 defects are found; 2 when the file cannot be read.";
+
+/// `latvox check`.
+pub(crate) const COMMAND: Command = Command::new(
+    "check",
+    "Check a mesh file: every defect counted (holes, non-manifold, winding, normals, degenerate and duplicate facets, T-junctions, self-intersections), per shell too",
+    EXAMPLES,
+    <CheckArgs as clap::Args>::augment_args,
+    |m, quiet| run(&parsed(m)?, quiet),
+);
 
 #[derive(Args)]
 pub struct CheckArgs {

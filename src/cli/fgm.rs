@@ -2,6 +2,7 @@
 //! signed distance grid, material fractions graded by the distance to features, and the files a
 //! multi-material printer or a simulation takes.
 
+use super::command::{job, parsed, Command, PartKeys};
 use super::out::outln;
 use super::{cgal_findings, parse_positive, write_json};
 use clap::Args;
@@ -64,6 +65,56 @@ same field in the plane, sampled at the nodes x0 + i·h, y0 + j·h. Outputs: -o 
 signed distance image (one row per line, lowest y first), --svg the outline (the zero
 iso-line, by marching squares), --preview the image coloured by composition; features
 point:X,Y, curve:FILE (x y per line) and skin.";
+
+/// `latvox fgm`.
+pub(crate) const COMMAND: Command = Command {
+    part: Some(PartKeys {
+        own: &[
+            "points",
+            "2d",
+            "mesh",
+            "voxel",
+            "sign",
+            "feature",
+            "weights",
+            "materials",
+            "law",
+            "dmax",
+            "palette",
+            "dpi",
+            "layer",
+        ],
+        shared: &[],
+    }),
+    job: Some(job::<FgmArgs>),
+    ..Command::new(
+        "fgm",
+        "Functionally graded material from distance fields: a scanned point cloud (or a mesh) to a signed distance grid, material fractions graded by the distance to features, and .vdb grids, a coloured mesh and voxel-print PNG stacks",
+        EXAMPLES,
+        <FgmArgs as clap::Args>::augment_args,
+        |m, quiet| run(&parsed(m)?, quiet),
+    )
+};
+
+impl latvox::batch::Task for FgmArgs {
+    fn outputs(&self) -> Vec<PathBuf> {
+        outputs(self)
+    }
+
+    fn run(&self) -> Result<latvox::batch::TaskReport> {
+        if self.two_d {
+            let r = execute_plane(self, &Progress::hidden())?;
+            return Ok(latvox::batch::TaskReport {
+                report: serde_json::to_value(&r).map_err(|e| Error::invalid(e.to_string()))?,
+                passed: true,
+                warnings: Vec::new(),
+            });
+        }
+        let r = execute(self, &Progress::hidden())?;
+        let verdict = r.checks.verdict();
+        latvox::batch::TaskReport::new(&r, &verdict, Vec::new())
+    }
+}
 
 /// Default colours, one per material in order.
 const PALETTE: [[u8; 3]; 6] = [

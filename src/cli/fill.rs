@@ -1,8 +1,10 @@
 //! `latvox fill`: a part kept as a solid skin, its core filled with a lattice at an exact
 //! density, solids kept whole where asked.
 
+use super::command::{job, parsed, Command, PartKeys};
 use super::lattice::{human, print_grading, print_part, triple, GradeArgs, MeshArgs, PartArgs};
 use super::out::outln;
+use super::part::Part;
 use super::tpms::parse_structure;
 use super::{parse_density, parse_length0, parse_positive, parse_positive3};
 use clap::Args;
@@ -49,6 +51,60 @@ part solid and the skin alone to measure that region, then finds the lattice lev
 written mesh has the density. Lattice pieces the part's surface cuts loose from the rest are
 removed (counted in the summary and report), so the part is one piece; the whole written mesh
 is verified (--verify).";
+
+/// `latvox fill`.
+pub(crate) const COMMAND: Command = Command {
+    part: Some(PartKeys {
+        own: &[
+            "input",
+            "skin",
+            "no-skin",
+            "lattice",
+            "structure",
+            "cell-size",
+            "density",
+            "density-grade",
+            "density-field",
+            "clamp",
+            "blend",
+            "drain",
+            "keep",
+        ],
+        shared: super::part::MESHING,
+    }),
+    job: Some(job::<FillArgs>),
+    trace: Some(|m| {
+        Ok(Part::Filled(Box::new(
+            parsed::<FillArgs>(m)?.job()?.traced()?,
+        )))
+    }),
+    choices: Some(|| {
+        let lattices: Vec<&str> = Surface::ALL
+            .map(|s| s.name())
+            .into_iter()
+            .chain(BUILT_IN.iter().copied())
+            .collect();
+        serde_json::json!({ "lattice": lattices, "structure": ["net", "sheet"] })
+    }),
+    ..Command::new(
+        "fill",
+        "Fill a part with a lattice: a solid skin of the part's shape, its core a TPMS or strut lattice at an exact density, solids kept whole where asked",
+        EXAMPLES,
+        <FillArgs as clap::Args>::augment_args,
+        |m, quiet| run(&parsed(m)?, quiet),
+    )
+};
+
+impl latvox::batch::Task for FillArgs {
+    fn outputs(&self) -> Vec<PathBuf> {
+        vec![self.mesh.output.clone()]
+    }
+
+    fn run(&self) -> Result<latvox::batch::TaskReport> {
+        let r = execute(self, &latvox::progress::Progress::hidden())?;
+        latvox::batch::TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
+    }
+}
 
 #[derive(Args)]
 pub struct FillArgs {

@@ -1,10 +1,13 @@
 //! Pieces shared by the subcommands: option parsers, JSON output, summary formatting.
-//! Each subcommand lives in its own file and exposes `Args` (clap) and `run`.
+//! Each subcommand lives in its own file and defines itself once, as a [`command::Command`]
+//! named `COMMAND`; [`COMMANDS`] lists them.
 
 pub mod batch;
 pub mod check;
+pub(crate) mod command;
 pub mod fgm;
 pub mod fill;
+pub mod interpret;
 pub mod lattice;
 pub(crate) mod out;
 pub mod part;
@@ -12,13 +15,28 @@ pub mod render;
 pub mod repair;
 pub mod slice;
 pub mod strut;
-pub mod topo;
 pub mod topopt;
 pub mod tpms;
 pub mod view;
 
 use latvox::Result;
 use std::path::Path;
+
+/// Every subcommand, in the order the help lists them.
+pub(crate) const COMMANDS: &[&command::Command] = &[
+    &tpms::COMMAND,
+    &strut::COMMAND,
+    &fill::COMMAND,
+    &check::COMMAND,
+    &repair::COMMAND,
+    &topopt::COMMAND,
+    &interpret::COMMAND,
+    &fgm::COMMAND,
+    &render::COMMAND,
+    &view::COMMAND,
+    &slice::COMMAND,
+    &batch::COMMAND,
+];
 
 pub(crate) fn split3<T: Copy>(
     s: &str,

@@ -10,87 +10,11 @@
 //! the solids kept), it is relative to the part file.
 
 use super::clap_message;
-use clap::{Args, FromArgMatches};
+use super::command::{find, names_with, Command};
 use latvox::fill::traced::Traced;
 use latvox::render::Model;
 use latvox::{Error, Result};
 use std::path::Path;
-
-/// The options that define a part, per subcommand (beside [`COMMON`]): everything but where
-/// its files go.
-const PART_KEYS: &[(&str, &[&str])] = &[
-    (
-        "tpms",
-        &[
-            "type",
-            "structure",
-            "side",
-            "density",
-            "density-grade",
-            "density-field",
-            "clamp",
-            "blend-to",
-            "blend-field",
-            "cell-map",
-            "bore",
-            "layers",
-            "cell-size-grade",
-            "cell-size-field",
-            "allow-islands",
-        ],
-    ),
-    (
-        "strut",
-        &[
-            "cell",
-            "density",
-            "radius",
-            "density-grade",
-            "density-field",
-            "clamp",
-            "blend",
-        ],
-    ),
-    (
-        "fill",
-        &[
-            "input",
-            "skin",
-            "no-skin",
-            "lattice",
-            "structure",
-            "cell-size",
-            "density",
-            "density-grade",
-            "density-field",
-            "clamp",
-            "blend",
-            "drain",
-            "keep",
-        ],
-    ),
-    (
-        "fgm",
-        &[
-            "points",
-            "2d",
-            "mesh",
-            "voxel",
-            "sign",
-            "feature",
-            "weights",
-            "materials",
-            "law",
-            "dmax",
-            "palette",
-            "dpi",
-            "layer",
-        ],
-    ),
-];
-
-/// The commands whose parts are lattices in a box (they share [`COMMON`]).
-const LATTICES: &[&str] = &["tpms", "strut", "fill"];
 
 /// Options naming files that define the part (the mesh filled, the solids kept, the scan):
 /// saved as absolute paths, so that the part file makes the same part from any folder.
@@ -120,12 +44,20 @@ fn embedded_file(v: &str) -> Option<(&str, &str)> {
         .then_some((kind, file))
 }
 
-/// The options of the box and the meshing that define any lattice part.
-const COMMON: &[&str] = &[
+/// The options of the box and the meshing that define a lattice part in a box.
+pub(crate) const LATTICE_BOX: &[&str] = &[
     "cells",
     "cell-size",
     "size",
     "origin",
+    "resolution",
+    "fixed-resolution",
+    "adaptivity",
+    "keep-fragments",
+];
+
+/// The options of the meshing that define a lattice part whose box is another part's.
+pub(crate) const MESHING: &[&str] = &[
     "resolution",
     "fixed-resolution",
     "adaptivity",
@@ -146,28 +78,19 @@ const EXCLUSIVE: &[[&str; 2]] = &[
 /// The short forms of long options, to tell whether the command line gave one.
 const SHORT: &[(&str, &str)] = &[("type", "-t"), ("density", "-d"), ("resolution", "-r")];
 
-fn keys(command: &str) -> Vec<&'static str> {
-    let own = PART_KEYS
-        .iter()
-        .find(|(c, _)| *c == command)
-        .map_or(&[][..], |(_, k)| k);
-    let common = if LATTICES.contains(&command) {
-        COMMON
-    } else {
-        &[]
+/// The settings a part of `command` holds (none for a command without part files).
+pub(crate) fn keys(command: &Command) -> Vec<&'static str> {
+    let Some(part) = command.part else {
+        return Vec::new();
     };
-    own.iter().chain(common).copied().collect()
+    part.own.iter().chain(part.shared).copied().collect()
 }
 
-/// Writes the part file of `command` (its clap command `cmd`) run with `matches`, atomically.
-pub fn save(
-    path: &Path,
-    command: &str,
-    cmd: &clap::Command,
-    matches: &clap::ArgMatches,
-) -> Result<()> {
+/// Writes the part file of `command` run with `matches`, atomically.
+pub fn save(path: &Path, command: &Command, matches: &clap::ArgMatches) -> Result<()> {
+    let cmd = command.clap();
     let mut table = toml::Table::new();
-    table.insert("command".into(), toml::Value::String(command.into()));
+    table.insert("command".into(), toml::Value::String(command.name.into()));
     for key in keys(command) {
         // The option, or an argument of that name (`fill`'s PART, also given as `--input`).
         let ids = |key: &str| -> Vec<String> {
@@ -326,7 +249,7 @@ pub(crate) fn read(path: &Path) -> Result<toml::Table> {
 
 /// `argv` (a subcommand's arguments, after its name) with the options of the part file it
 /// names with `--part` put in front, those the command line gives itself left out.
-pub fn expand(command: &str, argv: Vec<String>) -> Result<Vec<String>> {
+pub fn expand(command: &Command, argv: Vec<String>) -> Result<Vec<String>> {
     let at = argv
         .iter()
         .position(|a| a == "--part" || a.starts_with("--part="));
@@ -345,23 +268,25 @@ pub fn expand(command: &str, argv: Vec<String>) -> Result<Vec<String>> {
 /// `argv` with the options of a part file's `table` (the file at `path`, which files it names
 /// are relative to) put in front, those the command line gives itself left out.
 fn expand_table(
-    command: &str,
+    command: &Command,
     argv: Vec<String>,
     table: &toml::Table,
     path: &Path,
 ) -> Result<Vec<String>> {
     match table.get("command").and_then(toml::Value::as_str) {
-        Some(c) if c == command => {}
+        Some(c) if command.is(c) => {}
         Some(c) => {
             return Err(Error::invalid(format!(
-                "{} is a part of `latvox {c}`, not of `latvox {command}`",
-                path.display()
+                "{} is a part of `latvox {c}`, not of `latvox {}`",
+                path.display(),
+                command.name
             )))
         }
         None => {
             return Err(Error::invalid(format!(
-                "{}: a part file needs `command` (\"tpms\", \"strut\", \"fill\" or \"fgm\")",
-                path.display()
+                "{}: a part file needs `command` ({})",
+                path.display(),
+                names_with(|c| c.part.is_some())
             )))
         }
     }
@@ -382,8 +307,9 @@ fn expand_table(
         let key = key.replace('_', "-");
         if !keys(command).contains(&key.as_str()) {
             return Err(Error::invalid(format!(
-                "{}: '{key}' is not a setting of a {command} part (settings: {})",
+                "{}: '{key}' is not a setting of a {} part (settings: {})",
                 path.display(),
+                command.name,
                 keys(command).join(", ")
             )));
         }
@@ -461,52 +387,35 @@ pub(crate) fn part_of_table(table: &toml::Table, path: &Path) -> Result<Part> {
         .unwrap_or_default()
         .to_string();
     // A setting the part file gives wrongly: said of the part file.
-    let named = |e: Error| match e {
-        Error::Invalid(m) if !m.contains(&path.display().to_string()) => {
-            Error::invalid(format!("{}: {m}", path.display()))
+    let named = |e: Error| {
+        let name = path.display().to_string();
+        if e.to_string().contains(&name) {
+            e
+        } else {
+            e.prefixed(&name)
         }
-        e => e,
     };
     part_from(&command, table, path).map_err(named)
 }
 
 fn part_from(command: &str, table: &toml::Table, path: &Path) -> Result<Part> {
-    match command {
-        "tpms" => Ok(Part::Block(
-            parse::<super::tpms::TpmsArgs>("tpms", table, path)?
-                .job()?
-                .model()?,
-        )),
-        "strut" => Ok(Part::Block(
-            parse::<super::strut::StrutArgs>("strut", table, path)?
-                .job()?
-                .model()?,
-        )),
-        "fill" => Ok(Part::Filled(Box::new(
-            parse::<super::fill::FillArgs>("fill", table, path)?
-                .job()?
-                .traced()?,
-        ))),
-        _ => Err(Error::invalid(format!(
-            "{}: a part file needs `command` (\"tpms\", \"strut\" or \"fill\")",
-            path.display()
-        ))),
-    }
-}
-
-fn parse<A: Args + FromArgMatches>(
-    name: &'static str,
-    table: &toml::Table,
-    path: &Path,
-) -> Result<A> {
-    let argv = expand_table(name, Vec::new(), table, path)?;
-    let mut cmd = A::augment_args(clap::Command::new(name))
-        .no_binary_name(true)
-        .disable_help_flag(true);
-    let m = cmd
-        .try_get_matches_from_mut(argv)
+    let traced = |c: &&Command| c.trace.is_some();
+    let Some((command, trace)) = find(command)
+        .filter(traced)
+        .and_then(|c| Some((c, c.trace?)))
+    else {
+        return Err(Error::invalid(format!(
+            "{}: a part file needs `command` ({})",
+            path.display(),
+            names_with(|c| c.trace.is_some())
+        )));
+    };
+    let argv = expand_table(command, Vec::new(), table, path)?;
+    let m = command
+        .parser()
+        .try_get_matches_from(argv)
         .map_err(|e| Error::invalid(clap_message(e)))?;
-    A::from_arg_matches(&m).map_err(|e| Error::invalid(clap_message(e)))
+    trace(&m)
 }
 
 pub(crate) fn is_part_file(path: &Path) -> bool {

@@ -1,6 +1,7 @@
 //! `latvox render`: a picture of a part straight from its part file (sphere-traced, never
 //! meshed), or of a mesh file (ray cast through a BVH).
 
+use super::command::{parsed, Command};
 use super::out::outln;
 use super::part::{is_part_file, part_of, Part};
 use super::{emit_json, parse_f64};
@@ -33,6 +34,15 @@ the level its density model gives — no mesh is made, so a part of a million ce
 fast as one of a thousand. A mesh file (.stl, .3mf, .obj, .off, .ply) is ray cast as it is.
 Angles: the azimuth turns about z from the front (eye on −y, 0°) towards the right (eye on +x,
 90°); the elevation lifts the eye above the xy plane.";
+
+/// `latvox render`.
+pub(crate) const COMMAND: Command = Command::new(
+    "render",
+    "Render a picture of a part file, sphere-traced from its implicit solid without meshing it, or of a mesh file, ray cast",
+    EXAMPLES,
+    <RenderArgs as clap::Args>::augment_args,
+    |m, _| run(&parsed(m)?),
+);
 
 /// The most pixels one picture holds (all views together): some 1.3 GB of colour and depth.
 const MAX_PIXELS: u64 = 100_000_000;

@@ -2,6 +2,7 @@
 //! before and after.
 
 use super::check::{print_header, print_summary};
+use super::command::{job, parsed, Command};
 use super::out::outln;
 use clap::Args;
 use latvox::mesh::output::MeshFile;
@@ -49,6 +50,29 @@ Self-intersections are counted on the result only (--solid and --remesh mend the
 Exit codes: 0 the result written is a valid closed solid; 1 it is written but defects remain
 (listed); 2 bad input or arguments, or no solid exists (nothing written); 3 an internal failure
 (a bug to report).";
+
+/// `latvox repair`.
+pub(crate) const COMMAND: Command = Command {
+    job: Some(job::<RepairArgs>),
+    ..Command::new(
+        "repair",
+        "Repair a mesh file and report every change by kind and count",
+        EXAMPLES,
+        <RepairArgs as clap::Args>::augment_args,
+        |m, quiet| run(&parsed(m)?, quiet),
+    )
+};
+
+impl latvox::batch::Task for RepairArgs {
+    fn outputs(&self) -> Vec<PathBuf> {
+        vec![self.output.clone()]
+    }
+
+    fn run(&self) -> Result<latvox::batch::TaskReport> {
+        let r = execute(self, &Progress::hidden())?;
+        latvox::batch::TaskReport::new(&r, &r.verdict, Vec::new())
+    }
+}
 
 #[derive(Args)]
 pub struct RepairArgs {

@@ -1,6 +1,7 @@
 //! `latvox slice`: a mesh file cut into layers — CLI, SVG, PNG masks, SL1 — with a per-layer
 //! table.
 
+use super::command::{job, parsed, Command};
 use super::out::outln;
 use super::part::{is_part_file, part_of, Part};
 use clap::{Args, ValueEnum};
@@ -51,6 +52,33 @@ keeps the stair-step cusp h * |cos(angle between normal and build direction)| un
 
 Exit code 0 when every loop closed; 1 when some chain could not close (the files are written,
 the open chains marked: CLI direction 2, red in SVG); 2 on bad input.";
+
+/// `latvox slice`.
+pub(crate) const COMMAND: Command = Command {
+    job: Some(job::<SliceArgs>),
+    ..Command::new(
+        "slice",
+        "Slice a mesh file, or a part file without meshing it, into layers for printing: CLI (Common Layer Interface), SVG, PNG masks, SL1; uniform or adaptive layers, any build direction",
+        EXAMPLES,
+        <SliceArgs as clap::Args>::augment_args,
+        |m, quiet| run(&parsed(m)?, quiet),
+    )
+};
+
+impl latvox::batch::Task for SliceArgs {
+    fn outputs(&self) -> Vec<PathBuf> {
+        outputs(self)
+    }
+
+    fn run(&self) -> Result<latvox::batch::TaskReport> {
+        let r = execute(self, false, &latvox::progress::Progress::hidden())?;
+        Ok(latvox::batch::TaskReport {
+            report: serde_json::to_value(&r).map_err(|e| latvox::Error::invalid(e.to_string()))?,
+            passed: r.open_chains == 0,
+            warnings: Vec::new(),
+        })
+    }
+}
 
 /// How adaptive layers are chosen.
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -1,9 +1,11 @@
 //! `latvox strut`: a closed strut (beam) lattice at an exact volume fraction or strut radius.
 
+use super::command::{job, parsed, Command, PartKeys};
 use super::lattice::{
     human, print_grading, print_part, triple, BoxArgs, GradeArgs, MeshArgs, PartArgs,
 };
 use super::out::outln;
+use super::part::Part;
 use super::{parse_density, parse_length0, parse_positive, write_json};
 use clap::Args;
 use latvox::strut::cell::BUILT_IN;
@@ -50,6 +52,42 @@ A strut is a capsule (a cone with rounded ends where its two nodes' radius facto
 report gives the radius, the fraction measured on the written mesh, and its checks. Radii at
 which struts would be under 2 voxels across raise the resolution; radii at which the pores
 between struts close are refused, with the range the cell allows.";
+
+/// `latvox strut`.
+pub(crate) const COMMAND: Command = Command {
+    part: Some(PartKeys {
+        own: &[
+            "cell",
+            "density",
+            "radius",
+            "density-grade",
+            "density-field",
+            "clamp",
+            "blend",
+        ],
+        shared: super::part::LATTICE_BOX,
+    }),
+    job: Some(job::<StrutArgs>),
+    trace: Some(|m| Ok(Part::Block(parsed::<StrutArgs>(m)?.job()?.model()?))),
+    choices: Some(|| serde_json::json!({ "cell": BUILT_IN })),
+    ..Command::new(
+        "strut",
+        "Generate a closed strut (beam) lattice — BCC, octet, Kelvin or a cell of your own — at an exact volume fraction or strut radius",
+        EXAMPLES,
+        <StrutArgs as clap::Args>::augment_args,
+        |m, quiet| run(&parsed(m)?, quiet),
+    )
+};
+
+impl latvox::batch::Task for StrutArgs {
+    fn outputs(&self) -> Vec<std::path::PathBuf> {
+        vec![self.mesh.output.clone()]
+    }
+
+    fn run(&self) -> Result<latvox::batch::TaskReport> {
+        execute(self, &latvox::progress::Progress::hidden())?.task_report()
+    }
+}
 
 #[derive(Args)]
 pub struct StrutArgs {

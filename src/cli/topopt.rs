@@ -1,6 +1,7 @@
 //! `latvox topopt`: SIMP minimum-compliance optimisation; writes the densities (.npy), the
 //! per-iteration log and a JSON report.
 
+use super::command::{parsed, Command};
 use super::out::outln;
 use super::write_json;
 use clap::{Args, ValueEnum};
@@ -16,7 +17,7 @@ Examples:
 
   # Liu et al. 2018's cantilever (120 × 40 mm on 30 × 10 elements), then to STL and CAD
   latvox topopt --problem cantilever --volfrac 0.3 -o cantilever.npy
-  latvox topo cantilever.npy --element-size 4 --thickness 4 -o cantilever.stl --iges c.igs
+  latvox interpret cantilever.npy --element-size 4 --thickness 4 -o cantilever.stl --iges c.igs
 
   # top3d's cantilever, 3D
   latvox topopt --problem cantilever3d --nelx 30 --nely 10 --nelz 4 --volfrac 0.3 -o c3.npy
@@ -49,6 +50,15 @@ in elements; passive element ranges are half-open.
 The .npy holds the physical densities, shape (nely, nelx) or (nely, nelx, nelz), row 0 at the
 top (as the published MATLAB codes' xPhys). The report holds `compliance` (one value per
 iteration) and `iterations`.";
+
+/// `latvox topopt`.
+pub(crate) const COMMAND: Command = Command::new(
+    "topopt",
+    "SIMP topology optimisation (88-line code in 2D, top3d in 3D): densities to .npy",
+    EXAMPLES,
+    <TopoptArgs as clap::Args>::augment_args,
+    |m, quiet| run(&parsed(m)?, quiet),
+);
 
 #[derive(Clone, Copy, ValueEnum)]
 pub enum FilterArg {
@@ -86,7 +96,7 @@ pub struct TopoptArgs {
     /// Stop after this many iterations even if the change is still above 0.01.
     #[arg(long, default_value_t = 1000)]
     pub max_iterations: usize,
-    /// Element size in mm, recorded in the report for `latvox topo`.
+    /// Element size in mm, recorded in the report for `latvox interpret`.
     #[arg(long, value_name = "MM")]
     pub element_size: Option<f64>,
     /// Output densities (.npy).

@@ -1,10 +1,12 @@
 //! `latvox tpms`: a closed TPMS lattice at an exact volume fraction.
 
+use super::command::{job, parsed, Command, PartKeys};
 use super::lattice::{
     human, print_grading, print_part, triple, BoxArgs, GradeArgs, MeshArgs, PartArgs,
 };
 use super::out::outln;
 use super::parse_density;
+use super::part::Part;
 use clap::Args;
 use latvox::tpms::{Structure, Surface, TpmsJob, TpmsReport};
 use latvox::Result;
@@ -73,6 +75,56 @@ Structures: net (solid on one side of F = t; --side other for the other labyrint
 The level t is found by latvox so that the written mesh has the requested volume fraction;
 the report gives the target, the fraction measured on the written mesh, and its checks
 (--verify: closed, manifold, outward and no self-intersection by default).";
+
+/// `latvox tpms`.
+pub(crate) const COMMAND: Command = Command {
+    part: Some(PartKeys {
+        own: &[
+            "type",
+            "structure",
+            "side",
+            "density",
+            "density-grade",
+            "density-field",
+            "clamp",
+            "blend-to",
+            "blend-field",
+            "cell-map",
+            "bore",
+            "layers",
+            "cell-size-grade",
+            "cell-size-field",
+            "allow-islands",
+        ],
+        shared: super::part::LATTICE_BOX,
+    }),
+    job: Some(job::<TpmsArgs>),
+    trace: Some(|m| Ok(Part::Block(parsed::<TpmsArgs>(m)?.job()?.model()?))),
+    choices: Some(|| {
+        serde_json::json!({
+            "type": Surface::ALL.map(|s| s.name()),
+            "structure": ["net", "sheet"],
+        })
+    }),
+    ..Command::new(
+        "tpms",
+        "Generate a closed TPMS lattice at an exact volume fraction",
+        EXAMPLES,
+        <TpmsArgs as clap::Args>::augment_args,
+        |m, quiet| run(&parsed(m)?, quiet),
+    )
+};
+
+impl latvox::batch::Task for TpmsArgs {
+    fn outputs(&self) -> Vec<std::path::PathBuf> {
+        vec![self.mesh.output.clone()]
+    }
+
+    fn run(&self) -> Result<latvox::batch::TaskReport> {
+        let r = execute(self, &latvox::progress::Progress::hidden())?;
+        latvox::batch::TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
+    }
+}
 
 #[derive(Args)]
 pub struct TpmsArgs {

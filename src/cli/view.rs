@@ -1,12 +1,12 @@
 //! `latvox view`: the browser editor of a part file — a local server whose page sphere-traces
 //! the part on the GPU and edits it live (see `latvox::render::view`).
 
+use super::command::{parsed, Command};
 use super::part::{absolute, is_part_file, part_of_table, read, Part};
 use clap::Args;
 use latvox::render::view::scene::Scene;
 use latvox::render::view::{serve, Editor, Hooks};
 use latvox::{Error, Result};
-use serde_json::json;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -33,6 +33,15 @@ lattice, cell size, density or radius, skin, blend, drains, the box) and cut it 
 plane. \"Save part\" writes the part file; \"Mesh\" and \"Slice\" run latvox on the
 saved settings and show their progress. The server listens on 127.0.0.1 only and serves until
 it is stopped (Ctrl-C).";
+
+/// `latvox view`.
+pub(crate) const COMMAND: Command = Command::new(
+    "view",
+    "Edit a part file live in the browser: a local server whose page sphere-traces the part on the GPU (no mesh), with controls, sections, saving, meshing and slicing",
+    EXAMPLES,
+    <ViewArgs as clap::Args>::augment_args,
+    |m, _| run(&parsed(m)?),
+);
 
 #[derive(Args)]
 pub struct ViewArgs {
@@ -70,16 +79,9 @@ pub fn run(a: &ViewArgs) -> Result<i32> {
     };
     // The part must be drawable before anything is served.
     (hooks.scene)(&settings)?;
-    let types = latvox::tpms::Surface::ALL.map(|s| s.name());
-    let cells = latvox::strut::cell::BUILT_IN;
-    let choices = match command.as_str() {
-        "tpms" => json!({ "type": types, "structure": ["net", "sheet"] }),
-        "strut" => json!({ "cell": cells }),
-        _ => json!({
-            "lattice": types.iter().chain(cells.iter()).collect::<Vec<_>>(),
-            "structure": ["net", "sheet"],
-        }),
-    };
+    let choices = super::command::find(&command)
+        .and_then(|c| c.choices)
+        .map_or(serde_json::Value::Null, |choices| choices());
     let server = tiny_http::Server::http(("127.0.0.1", a.port))
         .map_err(|e| Error::invalid(format!("cannot listen on 127.0.0.1:{}: {e}", a.port)))?;
     let port = server

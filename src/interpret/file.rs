@@ -1,9 +1,9 @@
-//! A density-field file to a part, as `latvox topo` does: read the field, settle the options that
+//! A density-field file to a part, as `latvox interpret` does: read the field, settle the options that
 //! depend on it, run the job, and write the part and every other file asked for (CAD curves,
 //! boundary points, the cleaned grid, stage images), each atomically. The report is the
 //! caller's to write.
 
-use super::job::{self, TopoJob, TopoResult};
+use super::job::{self, InterpretJob, InterpretResult};
 use super::{images, CleanOptions, Density};
 use crate::error::{Error, Result};
 use crate::grid::Smoothing;
@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 /// What a user asks of the job; `None` takes a default that depends on the field.
 #[derive(Debug, Clone, Copy)]
-pub struct TopoOptions {
+pub struct InterpretOptions {
     /// Element edge length, mm.
     pub element_size: f64,
     /// Threshold density (step 1.1).
@@ -45,9 +45,9 @@ const MAX_DEFAULT_PIXELS: usize = 200_000_000;
 /// Smoothing passes allowed at most.
 const MAX_SMOOTH: u32 = 100;
 
-impl TopoOptions {
+impl InterpretOptions {
     /// The job for field `d`: defaults filled in, the options checked against the field.
-    pub fn job(&self, d: &Density) -> Result<TopoJob> {
+    pub fn job(&self, d: &Density) -> Result<InterpretJob> {
         if !d.is_3d && self.refine.is_none() && (d.nx * 8) * (d.ny * 8) > MAX_DEFAULT_PIXELS {
             return Err(Error::invalid(
                 "field too large for --refine 8; give a smaller --refine",
@@ -73,7 +73,7 @@ impl TopoOptions {
         if self.smooth_iterations > MAX_SMOOTH {
             return Err(Error::invalid("--smooth takes at most 100 passes"));
         }
-        Ok(TopoJob {
+        Ok(InterpretJob {
             clean: CleanOptions {
                 cutoff: self.cutoff,
                 refine,
@@ -94,7 +94,7 @@ impl TopoOptions {
 
 /// The files the job writes besides its report.
 #[derive(Debug, Clone)]
-pub struct TopoFiles {
+pub struct InterpretFiles {
     /// The part, in the format its extension names.
     pub mesh: PathBuf,
     /// ASCII STL (or ASCII PLY).
@@ -113,7 +113,7 @@ pub struct TopoFiles {
     pub images: Option<PathBuf>,
 }
 
-impl TopoFiles {
+impl InterpretFiles {
     /// The uniform fits' IGES file, when asked for.
     pub fn uniform_iges(&self) -> Option<PathBuf> {
         let p = self.iges.as_ref().filter(|_| self.uniform_too)?;
@@ -144,9 +144,9 @@ impl TopoFiles {
 }
 
 /// What [`interpret_file`] made.
-pub struct TopoPart {
+pub struct InterpretPart {
     /// The job's results and report.
-    pub result: TopoResult,
+    pub result: InterpretResult,
     /// The stage images written, in order.
     pub images: Vec<PathBuf>,
 }
@@ -155,10 +155,10 @@ pub struct TopoPart {
 /// `files`. Every option and destination is checked before the work starts.
 pub fn interpret_file(
     input: &Path,
-    opts: &TopoOptions,
-    files: &TopoFiles,
+    opts: &InterpretOptions,
+    files: &InterpretFiles,
     progress: &Progress,
-) -> Result<TopoPart> {
+) -> Result<InterpretPart> {
     let d = Density::read(input, opts.element_size)?;
     if d.is_3d && (files.iges.is_some() || files.dxf.is_some()) {
         return Err(Error::invalid(
@@ -186,11 +186,11 @@ pub fn interpret_file(
         Some(prefix) => images::write_stages(&r.cleaned, prefix)?,
         None => Vec::new(),
     };
-    Ok(TopoPart { result: r, images })
+    Ok(InterpretPart { result: r, images })
 }
 
 /// Writes the CAD curves (IGES, DXF) and the boundary points the curves fit (CSV).
-fn write_curves(r: &TopoResult, files: &TopoFiles) -> Result<()> {
+fn write_curves(r: &InterpretResult, files: &InterpretFiles) -> Result<()> {
     if let Some(p) = &files.iges {
         crate::cad::iges::write_file(p, &r.adaptive)?;
     }
@@ -215,7 +215,7 @@ fn write_curves(r: &TopoResult, files: &TopoFiles) -> Result<()> {
 }
 
 /// Writes the cleaned solid on the refined grid as .npy of 0/1, in the input's layout.
-fn write_cleaned(r: &TopoResult, path: &Path) -> Result<()> {
+fn write_cleaned(r: &InterpretResult, path: &Path) -> Result<()> {
     let f = &r.cleaned.field;
     let solid = Density {
         nx: f.n[0],

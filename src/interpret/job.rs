@@ -18,7 +18,7 @@ use std::time::Instant;
 
 /// What to do besides cleaning.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct TopoJob {
+pub struct InterpretJob {
     /// The cleanup loop's options.
     pub clean: CleanOptions,
     /// Extrusion of a 2D field, mm.
@@ -80,9 +80,9 @@ pub struct Defects {
     pub min_radius: Option<f64>,
 }
 
-/// Everything `latvox topo` reports.
+/// Everything `latvox interpret` reports.
 #[derive(Debug, Clone, serde::Serialize)]
-pub struct TopoReport {
+pub struct InterpretReport {
     /// Elements along x, y, z (z = 0 for a 2D field).
     pub dims: [usize; 3],
     /// Whether the field is 3D.
@@ -90,7 +90,7 @@ pub struct TopoReport {
     /// Element edge length, mm.
     pub element_size: f64,
     /// The options the job ran with.
-    pub job: TopoJob,
+    pub job: InterpretJob,
     /// Pixel (voxel) edge length of the refined grid, mm.
     pub pixel_size: f64,
     /// Pixels (voxels) of the refined grid along x, y, z.
@@ -137,7 +137,7 @@ pub struct TopoReport {
 }
 
 /// Results of [`run`].
-pub struct TopoResult {
+pub struct InterpretResult {
     /// The cleanup loop's results.
     pub cleaned: Cleaned,
     /// The closed mesh (extruded in 2D, OpenVDB's in 3D).
@@ -149,7 +149,7 @@ pub struct TopoResult {
     /// Adaptive fit of each loop (written to IGES and DXF).
     pub adaptive: Vec<Periodic>,
     /// The report.
-    pub report: TopoReport,
+    pub report: InterpretReport,
 }
 
 fn defects(a: &super::features::Analysis, is_3d: bool) -> Defects {
@@ -161,7 +161,7 @@ fn defects(a: &super::features::Analysis, is_3d: bool) -> Defects {
     }
 }
 
-impl TopoReport {
+impl InterpretReport {
     /// The part's verdict: CGAL's checks of the mesh, and whether every feature is one the
     /// printer can make (no thin feature, island or point contact left after the last pass).
     pub fn verdict(&self) -> Verdict {
@@ -186,7 +186,7 @@ impl TopoReport {
 }
 
 /// Runs the job on `d`.
-pub fn run(d: &Density, job: &TopoJob, progress: &Progress) -> Result<TopoResult> {
+pub fn run(d: &Density, job: &InterpretJob, progress: &Progress) -> Result<InterpretResult> {
     let t0 = Instant::now();
     let mut timings = Timings::default();
     let mut cleaned = {
@@ -217,11 +217,11 @@ pub fn run(d: &Density, job: &TopoJob, progress: &Progress) -> Result<TopoResult
     };
     timings.fit = t.elapsed().as_secs_f64();
     timings.total = t0.elapsed().as_secs_f64();
-    let report = TopoReport {
+    let report = InterpretReport {
         timings,
         ..report(d, job, &cleaned, &mesh, &loops, checks, fits.loops)
     };
-    Ok(TopoResult {
+    Ok(InterpretResult {
         cleaned,
         mesh,
         loops,
@@ -240,7 +240,7 @@ fn pixel_measure(d: &Density, cleaned: &Cleaned, pixels: usize) -> f64 {
 /// The cleaned solid as a closed mesh, with its boundary loops in 2D: in 2D the outline
 /// extruded; in 3D OpenVDB's surface, moved to keep the thresholded volume (by its level, or
 /// after smoothing by an offset).
-fn mesh_solid(d: &Density, job: &TopoJob, cleaned: &mut Cleaned) -> Result<(Mesh, Vec<Loop>)> {
+fn mesh_solid(d: &Density, job: &InterpretJob, cleaned: &mut Cleaned) -> Result<(Mesh, Vec<Loop>)> {
     let goal = pixel_measure(d, cleaned, cleaned.target_pixels);
     let h = cleaned.field.h;
     if d.is_3d && job.smooth_iterations > 0 {
@@ -330,13 +330,13 @@ fn fit_loops(loops: &[Loop], tolerance: f64) -> Fits {
 /// The job's report (timings left at zero, for the caller to fill in).
 fn report(
     d: &Density,
-    job: &TopoJob,
+    job: &InterpretJob,
     cleaned: &Cleaned,
     mesh: &Mesh,
     loops: &[Loop],
     checks: Verification,
     fits: Vec<LoopFit>,
-) -> TopoReport {
+) -> InterpretReport {
     let thresholded_measure = pixel_measure(d, cleaned, cleaned.target_pixels);
     let final_measure = if d.is_3d {
         checks.volume.unwrap_or(f64::NAN)
@@ -347,7 +347,7 @@ fn report(
         fits.iter().map(|f| f.uniform_control_points).sum(),
         fits.iter().map(|f| f.adaptive_control_points).sum(),
     );
-    TopoReport {
+    InterpretReport {
         dims: [d.nx, d.ny, if d.is_3d { d.nz } else { 0 }],
         is_3d: d.is_3d,
         element_size: d.element_size,

@@ -11,7 +11,7 @@
 //! [`contour`] (boundary loops) → [`extrude`] (2D) or [`volume`] (3D, OpenVDB) → STL;
 //! [`images`] draws every stage; `crate::cad` fits and writes the curves. [`job`] runs the
 //! stages on a field; [`mod@file`] runs them from a field file to the part and the files asked
-//! for, as `latvox topo` and `latvox batch` do.
+//! for, as `latvox interpret` and `latvox batch` do.
 
 pub mod clean;
 pub mod contour;
@@ -28,4 +28,4 @@ pub mod volume;
 
 pub use clean::{clean, CleanOptions, Cleaned};
 pub use density::Density;
-pub use file::{interpret_file, TopoFiles, TopoOptions, TopoPart};
+pub use file::{interpret_file, InterpretFiles, InterpretOptions, InterpretPart};

@@ -55,9 +55,10 @@ pub fn check_density(d: f64) -> Result<()> {
     if d > 0.0 && d < 1.0 {
         return Ok(());
     }
-    Err(Error::invalid(format!(
-        "density must be in (0, 1), got {d}"
-    )))
+    Err(Error::setting(
+        "density",
+        format!("density must be in (0, 1), got {d}"),
+    ))
 }
 
 /// Refuses a blend radius that is not a length ≥ 0.
@@ -65,9 +66,10 @@ pub fn check_blend(blend: f64) -> Result<()> {
     if blend >= 0.0 && blend.is_finite() {
         return Ok(());
     }
-    Err(Error::invalid(format!(
-        "blend must be a length ≥ 0 mm, got {blend}"
-    )))
+    Err(Error::setting(
+        "blend",
+        format!("blend must be a length ≥ 0 mm, got {blend}"),
+    ))
 }
 
 /// Refuses fewer than 4 voxels per cell.
@@ -75,9 +77,10 @@ pub fn check_resolution(resolution: u32) -> Result<()> {
     if resolution >= 4 {
         return Ok(());
     }
-    Err(Error::invalid(format!(
-        "resolution must be at least 4 voxels per cell, got {resolution}"
-    )))
+    Err(Error::setting(
+        "resolution",
+        format!("resolution must be at least 4 voxels per cell, got {resolution}"),
+    ))
 }
 
 /// The finest resolution tried before a part is refused.
@@ -119,12 +122,16 @@ pub fn search<T>(
     };
     let Some((resolution, found)) = smallest_resolution(start, limit, &mut tried)? else {
         let closest = coarser.last().map_or(f64::NAN, |m| m.closest);
-        return Err(Error::invalid(format!(
-            "no level gives {} a density of {} within {PROMISE} at {} to {limit} voxels per cell (closest {closest:.4}); the box may cut the lattice into pieces",
-            request.part,
-            request.density.unwrap_or(f64::NAN),
-            request.requested,
-        )));
+        return Err(Error::Resolution {
+            requested: request.requested,
+            needed: None,
+            message: format!(
+                "no level gives {} a density of {} within {PROMISE} at {} to {limit} voxels per cell (closest {closest:.4}); the box may cut the lattice into pieces",
+                request.part,
+                request.density.unwrap_or(f64::NAN),
+                request.requested,
+            ),
+        });
     };
     coarser.sort_by_key(|m| m.resolution);
     if let Some(miss) = coarser.first().filter(|m| m.resolution == start) {
@@ -137,10 +144,14 @@ pub fn search<T>(
     }
     let raised = match passed_over.first() {
         Some(why) if !request.auto => {
-            return Err(Error::invalid(format!(
-                "{} at {}: {why}; use --resolution {resolution}, the smallest that works",
-                request.part, request.setting,
-            )))
+            return Err(Error::Resolution {
+                requested: request.requested,
+                needed: Some(resolution),
+                message: format!(
+                    "{} at {}: {why}; use --resolution {resolution}, the smallest that works",
+                    request.part, request.setting,
+                ),
+            })
         }
         Some(why) => Some(format!(
             "resolution raised from {} to {resolution} voxels per cell: {why}",

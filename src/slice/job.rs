@@ -137,9 +137,9 @@ impl Output {
 
     fn writer(&self, stack: &Stack, sharded: bool) -> Result<Box<dyn StackWriter>> {
         Ok(match self {
-            Output::Cli { path, binary } => {
-                Box::new(super::cli_file::CliWriter::create(path, stack, *binary)?)
-            }
+            Output::Cli { path, binary } => Box::new(super::common_layer::CliWriter::create(
+                path, stack, *binary,
+            )?),
             Output::Svg(p) => Box::new(super::svg::SvgWriter::create(p, stack)?),
             Output::SvgDir(p) => Box::new(super::svg::SvgDirWriter::create(p, stack, sharded)?),
             Output::PngDir { path, pixel } => Box::new(super::masks::PngDirWriter::create(

@@ -4,10 +4,10 @@
 //! stair-step cusp); [`mesh`] cuts a triangle mesh at the layers' mid-heights, chaining segments
 //! through the mesh's own edges so a closed solid gives closed loops; [`contour`] measures loops
 //! and nests them into polygons with holes; [`raster`] turns them into anti-aliased masks; the
-//! writers ([`cli_file`], [`svg`], [`masks`], [`csv`], [`plot`]) write the stack; [`job`] runs it all, as
+//! writers ([`common_layer`], [`svg`], [`masks`], [`csv`], [`plot`]) write the stack; [`job`] runs it all, as
 //! `latvox slice` and batch jobs do.
 
-pub mod cli_file;
+pub mod common_layer;
 pub mod contour;
 pub mod csv;
 pub mod implicit;

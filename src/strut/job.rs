@@ -182,9 +182,10 @@ impl StrutJob {
         match self.sizing {
             Sizing::Density(d) => resolution::check_density(d)?,
             Sizing::Radius(r) if !(r > 0.0 && r.is_finite()) => {
-                return Err(Error::invalid(format!(
-                    "radius must be a positive length in mm, got {r}"
-                )))
+                return Err(Error::setting(
+                    "radius",
+                    format!("radius must be a positive length in mm, got {r}"),
+                ))
             }
             _ => {}
         }
@@ -446,12 +447,16 @@ impl StrutJob {
         let needed = (req as f64 * MIN_STRUT_VOXELS / across).ceil() as u32;
         let why = format!("struts were {across:.2} voxels across at {req} voxels per cell");
         if self.auto_resolution && needed > max_resolution(req) {
-            return Err(Error::invalid(format!(
-                "the {} lattice at {}: {why}, and would need {needed} voxels per cell; give a larger radius or density (at {req} voxels per cell: radius ≥ {:.4} mm), or --resolution {needed}",
-                self.cell_name,
-                self.setting(),
-                0.5 * MIN_STRUT_VOXELS * self.voxel(req) / self.thinnest_factor(),
-            )));
+            return Err(Error::Resolution {
+                requested: req,
+                needed: Some(needed),
+                message: format!(
+                    "the {} lattice at {}: {why}, and would need {needed} voxels per cell; give a larger radius or density (at {req} voxels per cell: radius ≥ {:.4} mm), or --resolution {needed}",
+                    self.cell_name,
+                    self.setting(),
+                    0.5 * MIN_STRUT_VOXELS * self.voxel(req) / self.thinnest_factor(),
+                ),
+            });
         }
         Ok(Some((needed, why)))
     }
@@ -462,18 +467,24 @@ impl StrutJob {
             return Ok(());
         }
         let range = self.range(model, self.resolution);
-        Err(Error::invalid(format!(
-            "the {} lattice at {} closes up: its pores close at radius {:.4} mm (density {:.3}), trapping powder or resin; it can be built at radius {:.4} to {:.4} mm, density {:.3} to {:.3} (at {} voxels per cell)",
-            self.cell_name,
-            self.setting(),
-            range.max_radius,
-            range.max_density,
-            range.min_radius,
-            range.max_radius,
-            range.min_density,
-            range.max_density,
-            self.resolution
-        )))
+        Err(Error::Infeasible {
+            setting: "radius".into(),
+            value: r,
+            min: range.min_radius,
+            max: range.max_radius,
+            message: format!(
+                "the {} lattice at {} closes up: its pores close at radius {:.4} mm (density {:.3}), trapping powder or resin; it can be built at radius {:.4} to {:.4} mm, density {:.3} to {:.3} (at {} voxels per cell)",
+                self.cell_name,
+                self.setting(),
+                range.max_radius,
+                range.max_density,
+                range.min_radius,
+                range.max_radius,
+                range.min_density,
+                range.max_density,
+                self.resolution
+            ),
+        })
     }
 
     fn setting(&self) -> String {

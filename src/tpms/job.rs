@@ -283,14 +283,20 @@ impl TpmsJob {
                         r.min, r.max
                     )
                 });
-            return Err(Error::invalid(format!(
-                "density {} is outside the feasible range of a {} {} ({:.3} to {:.3}): the solid falls apart into islands (--allow-islands builds it anyway){hint}",
-                self.density,
-                s.name(),
-                st.name(),
-                range.min,
-                range.max
-            )));
+            return Err(Error::Infeasible {
+                setting: "density".into(),
+                value: self.density,
+                min: range.min,
+                max: range.max,
+                message: format!(
+                    "density {} is outside the feasible range of a {} {} ({:.3} to {:.3}): the solid falls apart into islands (--allow-islands builds it anyway){hint}",
+                    self.density,
+                    s.name(),
+                    st.name(),
+                    range.min,
+                    range.max
+                ),
+            });
         }
         let mut warnings = Vec::new();
         if !conn.solid {

@@ -1,6 +1,6 @@
 //! `latvox batch`, run as a user runs it: every job's part checked with computations independent
 //! of latvox (`common`: STL reading, edge counting, divergence volume), a batch job compared
-//! vertex for vertex with the same job run by `latvox tpms`, `topo` and `repair` jobs beside
+//! vertex for vertex with the same job run by `latvox tpms`, `interpret` (and its old name `topo`) and `repair` jobs beside
 //! `tpms` ones, a batch killed with SIGKILL and resumed, shards whose union is the whole batch,
 //! failures reported and retried.
 
@@ -220,12 +220,13 @@ fn write_open_cube(path: &Path) {
 }
 
 #[test]
-fn topo_and_repair_jobs_make_their_parts_and_are_recorded() {
+fn interpret_and_repair_jobs_make_their_parts_and_are_recorded() {
     let dir = tempdir();
     let d = dir.path();
     let field = write_plate_field(&d.join("plate.npy"));
     write_open_cube(&d.join("open.stl"));
-    let jobs = "[[job]]\ncommand = \"topo\"\ninput = \"plate.npy\"\noutput = \"out/plate.stl\"\n\
+    let jobs =
+        "[[job]]\ncommand = \"interpret\"\ninput = \"plate.npy\"\noutput = \"out/plate.stl\"\n\
                 element-size = 2\nmin-feature = 1\niges = \"out/plate.igs\"\n\n\
                 [[job]]\ncommand = \"topo\"\ninput = \"plate.npy\"\noutput = \"out/thin.stl\"\n\
                 element-size = 2\nmin-feature = 6\nmax-iterations = 1\n\n\
@@ -237,7 +238,7 @@ fn topo_and_repair_jobs_make_their_parts_and_are_recorded() {
 
     let rows = summary_rows(&d.join("jobs-summary.json"));
     let expect = [
-        (1, "topo", "out/plate.stl", "ok"),
+        (1, "interpret", "out/plate.stl", "ok"),
         (2, "topo", "out/thin.stl", "defects"),
         (3, "repair", "out/cube.stl", "ok"),
     ];
@@ -297,10 +298,10 @@ fn topo_and_repair_jobs_make_their_parts_and_are_recorded() {
     let v = volume(&read_stl(&d.join("out/cube.stl")));
     assert!((v - 1000.0).abs() < 1e-6, "volume {v}");
 
-    // The same part as `latvox topo` makes.
+    // The same part as `latvox interpret` makes.
     let o = run(
         &[
-            "topo",
+            "interpret",
             "plate.npy",
             "--element-size",
             "2",

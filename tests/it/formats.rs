@@ -169,7 +169,7 @@ fn lattice_commands_write_every_format() {
 }
 
 #[test]
-fn topo_and_fgm_write_every_format() {
+fn interpret_and_fgm_write_every_format() {
     let dir = tempdir();
     let d = dir.path();
     // A ring of elements (2D, extruded 3 mm).
@@ -187,7 +187,7 @@ fn topo_and_fgm_write_every_format() {
     every_format(
         d,
         &[
-            "topo",
+            "interpret",
             "ring.npy",
             "--element-size",
             "1",

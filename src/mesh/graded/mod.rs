@@ -152,14 +152,20 @@ impl Grading {
         }
         for (v, p) in [lo, hi] {
             if !self.clamp && (v < feasible.min || v > feasible.max) {
-                return Err(Error::invalid(format!(
-                    "the density field reaches {v:.4} at ({}), outside the feasible range of a {} ({:.3} to {:.3}), where {} (--clamp holds the field to the range)",
-                    point(p),
-                    feasible.what,
-                    feasible.min,
-                    feasible.max,
-                    feasible.why
-                )));
+                return Err(Error::Infeasible {
+                    setting: "density".into(),
+                    value: v,
+                    min: feasible.min,
+                    max: feasible.max,
+                    message: format!(
+                        "the density field reaches {v:.4} at ({}), outside the feasible range of a {} ({:.3} to {:.3}), where {} (--clamp holds the field to the range)",
+                        point(p),
+                        feasible.what,
+                        feasible.min,
+                        feasible.max,
+                        feasible.why
+                    ),
+                });
             }
         }
         let built = if self.clamp {

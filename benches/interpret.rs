@@ -1,13 +1,13 @@
-//! `topo` benchmarks, with the figures quoted in README.
+//! `interpret` benchmarks, with the figures quoted in the book's performance chapter.
 //!
-//! 1. The 2D pipeline on a 300 × 100 field, nc = 8 (a 2400 × 800 refined grid): the `latvox topo`
+//! 1. The 2D pipeline on a 300 × 100 field, nc = 8 (a 2400 × 800 refined grid): the `latvox interpret`
 //!    binary from the .npy to the STL (CGAL-verified), the IGES and the DXF. The field is a real
 //!    optimisation result: latvox's own half MBB beam, 300 × 100, volume fraction 0.4, rmin 3.
 //! 2. A 3D 120 × 40 × 40 field to a verified STL (nc = 2: a 240 × 80 × 80 grid). The field is
 //!    top3d's cantilever optimised on 30 × 10 × 10 elements by latvox, upsampled ×4 trilinearly.
 //!
 //! Wall time and peak resident memory of the child (`wait4`), median of several runs; the
-//! fields are made once, before timing. Run: `cargo bench --bench topo` (`-- --runs N`).
+//! fields are made once, before timing. Run: `cargo bench --bench interpret` (`-- --runs N`).
 
 use std::path::Path;
 use std::process::Command;
@@ -129,7 +129,7 @@ fn main() {
         (
             "2D 300x100, nc 8: clean, STL (CGAL incl. self-intersection), IGES, DXF",
             vec![
-                "topo".into(),
+                "interpret".into(),
                 f2.display().to_string(),
                 "--element-size".into(),
                 "1".into(),
@@ -148,7 +148,7 @@ fn main() {
         (
             "3D 120x40x40, nc 2: clean, OpenVDB mesh, STL (CGAL incl. self-intersection)",
             vec![
-                "topo".into(),
+                "interpret".into(),
                 f3.display().to_string(),
                 "--element-size".into(),
                 "1".into(),
@@ -173,7 +173,7 @@ fn main() {
                 .arg("-q")
                 .stdout(std::process::Stdio::null());
             let (s, m, code) = run_measured(&mut c);
-            assert!(code == 0 || code == 1, "latvox topo failed ({code})");
+            assert!(code == 0 || code == 1, "latvox interpret failed ({code})");
             walls.push(s);
             rss.push(m);
         }

@@ -1,4 +1,4 @@
-//! `latvox topo` on seed 003's examples, checked with computations independent of latvox:
+//! `latvox interpret` on the examples of Liu et al. (Engineering 2018), checked with computations independent of latvox:
 //! SciPy on the cleaned field (components, point contacts, local thickness), our test-side STL
 //! reader (edges, divergence volume), the input array itself (thresholded volume), OpenCASCADE
 //! through gmsh reading the IGES, and ezdxf reading the DXF.
@@ -79,7 +79,7 @@ fn seed_cantilever_becomes_a_clean_closed_part_and_cad_within_tolerance() {
     let p = |s: &str| d.join(s).to_str().unwrap().to_string();
     let out = ok(
         &[
-            "topo",
+            "interpret",
             &p("cantilever.npy"),
             "--element-size",
             "4",
@@ -221,7 +221,7 @@ fn adaptive_fitting_needs_at_most_60_percent_of_the_uniform_control_points() {
         let rep = d.join(format!("{problem}.json"));
         let o = run(
             &[
-                "topo",
+                "interpret",
                 npy.to_str().unwrap(),
                 "--element-size",
                 size,
@@ -292,7 +292,7 @@ fn three_d_field_meshes_closed_through_openvdb() {
     let stl = d.join("c3.stl");
     let topo3d = |out: &Path, extra: &[&str]| {
         let mut a = vec![
-            "topo",
+            "interpret",
             npy.to_str().unwrap(),
             "--element-size",
             "2",
@@ -394,7 +394,7 @@ fn csv_and_text_inputs_match_npy() {
         let rep = d.join(format!("{f}.json"));
         ok(
             &[
-                "topo",
+                "interpret",
                 d.join(f).to_str().unwrap(),
                 "--element-size",
                 "4",
@@ -447,7 +447,7 @@ fn bad_density_inputs_exit_2_with_one_line_and_write_nothing() {
         (vec!["cube.npy", "--cutoff", "1.5"], "cutoff"),
     ];
     for (args, want) in cases {
-        let mut a = vec!["topo"];
+        let mut a = vec!["interpret"];
         a.extend(args.iter());
         a.extend(["-o", "out.stl"]);
         let o = run(&a, d);

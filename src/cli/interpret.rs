@@ -1,13 +1,14 @@
-//! `latvox topo`: a density field to a printable STL and parametric CAD (feature-preserving
+//! `latvox interpret`: a density field to a printable STL and parametric CAD (feature-preserving
 //! cleanup and adaptive B-spline fitting, after Liu et al. 2018).
 
+use super::command::{self, parsed, Command};
 use super::out::outln;
 use super::{cgal_findings, write_json};
 use clap::Args;
 use latvox::check::verify::Verify;
 use latvox::grid::Smoothing;
 use latvox::interpret::job;
-use latvox::interpret::{interpret_file, TopoFiles, TopoOptions, TopoPart};
+use latvox::interpret::{interpret_file, InterpretFiles, InterpretOptions, InterpretPart};
 use latvox::progress::Progress;
 use latvox::Result;
 use std::path::PathBuf;
@@ -15,14 +16,14 @@ use std::path::PathBuf;
 pub(crate) const EXAMPLES: &str = "\
 Examples:
   # Liu et al. 2018's cantilever: 30 × 10 elements of 4 mm, 2 mm printer limit, 4 mm thick plate
-  latvox topo cantilever.npy --element-size 4 --cutoff 0.5 --refine 8 --min-feature 2 \\
+  latvox interpret cantilever.npy --element-size 4 --cutoff 0.5 --refine 8 --min-feature 2 \\
       --thickness 4 -o part.stl --iges part.igs --dxf part.dxf --report r.json --images stages
 
   # A 3D field (shape ny, nx, nz) straight to a closed STL through OpenVDB
-  latvox topo bracket3d.npy --element-size 1 --refine 2 --min-feature 1.5 -o bracket.stl
+  latvox interpret bracket3d.npy --element-size 1 --refine 2 --min-feature 1.5 -o bracket.stl
 
   # The same, smoothed by two passes of OpenVDB's Gaussian level-set filter
-  latvox topo bracket3d.npy --element-size 1 --refine 2 --smooth 2 -o bracket-smooth.stl
+  latvox interpret bracket3d.npy --element-size 1 --refine 2 --smooth 2 -o bracket-smooth.stl
 
 Input: .npy (float, int or bool; C or Fortran order), .csv (2D, one row per line) or text with a
 dimension header line `ny nx [nz]` then the values. 2D arrays are (ny, nx) with row 0 at the
@@ -44,6 +45,30 @@ the adaptive ones.
 Exit code 0: clean and valid; 1: defects remain after the last pass or a mesh check failed;
 2: bad input or arguments.";
 
+/// `latvox interpret` (formerly `latvox topo`).
+pub(crate) const COMMAND: Command = Command {
+    aliases: &["topo"],
+    job: Some(command::job::<InterpretArgs>),
+    ..Command::new(
+        "interpret",
+        "Density field to printable STL and parametric CAD (IGES, DXF): feature-preserving cleanup and adaptive B-spline fitting (Liu et al., Engineering 2018)",
+        EXAMPLES,
+        <InterpretArgs as clap::Args>::augment_args,
+        |m, quiet| run(&parsed(m)?, quiet),
+    )
+};
+
+impl latvox::batch::Task for InterpretArgs {
+    fn outputs(&self) -> Vec<PathBuf> {
+        self.files().paths()
+    }
+
+    fn run(&self) -> Result<latvox::batch::TaskReport> {
+        let r = execute(self, &Progress::hidden())?.result.report;
+        latvox::batch::TaskReport::new(&r, &r.verdict(), r.warnings())
+    }
+}
+
 #[derive(Clone, Copy, clap::ValueEnum)]
 pub enum SmoothArg {
     Gaussian,
@@ -53,7 +78,7 @@ pub enum SmoothArg {
 }
 
 #[derive(Args)]
-pub struct TopoArgs {
+pub struct InterpretArgs {
     /// Density field: .npy, .csv or text with a dimension header.
     pub input: PathBuf,
     /// Element edge length, mm.
@@ -123,10 +148,10 @@ pub struct TopoArgs {
     pub no_self_intersection_check: bool,
 }
 
-impl TopoArgs {
+impl InterpretArgs {
     /// The job's options.
-    pub(crate) fn options(&self) -> TopoOptions {
-        TopoOptions {
+    pub(crate) fn options(&self) -> InterpretOptions {
+        InterpretOptions {
             element_size: self.element_size,
             cutoff: self.cutoff,
             refine: self.refine,
@@ -151,8 +176,8 @@ impl TopoArgs {
     }
 
     /// The files the job writes besides its report.
-    pub(crate) fn files(&self) -> TopoFiles {
-        TopoFiles {
+    pub(crate) fn files(&self) -> InterpretFiles {
+        InterpretFiles {
             mesh: self.output.clone(),
             ascii: self.ascii,
             iges: self.iges.clone(),
@@ -167,11 +192,11 @@ impl TopoArgs {
 
 /// Runs the job and writes its files (not the report), for `run` to print and `latvox batch` to
 /// record.
-pub fn execute(a: &TopoArgs, progress: &Progress) -> Result<TopoPart> {
+pub fn execute(a: &InterpretArgs, progress: &Progress) -> Result<InterpretPart> {
     interpret_file(&a.input, &a.options(), &a.files(), progress)
 }
 
-pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
+pub fn run(a: &InterpretArgs, quiet: bool) -> Result<i32> {
     // Fail on an unwritable destination before the work, not after.
     if let Some(p) = &a.report {
         latvox::io::atomic::check_writable(p)?;
@@ -189,7 +214,7 @@ pub fn run(a: &TopoArgs, quiet: bool) -> Result<i32> {
     Ok(r.verdict().exit_code())
 }
 
-fn summary(r: &job::TopoReport, a: &TopoArgs, images: &[PathBuf]) {
+fn summary(r: &job::InterpretReport, a: &InterpretArgs, images: &[PathBuf]) {
     let dims = if r.is_3d {
         format!("{}×{}×{}", r.dims[0], r.dims[1], r.dims[2])
     } else {
