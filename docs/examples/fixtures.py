@@ -5,7 +5,7 @@ broken.stl: a 10 mm cube with one face missing and one facet turned over.
 assembly.3mf: two overlapping boxes as two objects (one solid only once united).
 scan.xyz: 4,000 points on a sphere of radius 8 mm (x y z per line, no normals), ±0.01 mm noise.
 cam.xy: a cam's profile r = 20 + 8·max(0, cos θ)² mm and a 6 mm bore (x y per line).
-grade.npy: a 3×3×3 density field, 0.2 at the bottom to 0.35 at the top.
+grade.npy: a 3×3×3 density field, 0.25 at the bottom to 0.4 at the top (x, y, z order).
 """
 import io
 import math
@@ -89,18 +89,23 @@ def model_xml(objects):
     return "".join(parts)
 
 
+def entry(name):
+    """A zip entry with a fixed date, so that the package is the same byte for byte."""
+    return zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
+
+
 with zipfile.ZipFile("assembly.3mf", "w", zipfile.ZIP_DEFLATED) as z:
-    z.writestr("[Content_Types].xml",
+    z.writestr(entry("[Content_Types].xml"),
                '<?xml version="1.0" encoding="UTF-8"?>\n<Types xmlns="http://schemas.openxmlformats.org/'
                'package/2006/content-types"><Default Extension="rels" ContentType="application/'
                'vnd.openxmlformats-package.relationships+xml"/><Default Extension="model" '
                'ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/></Types>\n')
-    z.writestr("_rels/.rels",
+    z.writestr(entry("_rels/.rels"),
                '<?xml version="1.0" encoding="UTF-8"?>\n<Relationships xmlns="http://schemas.'
                'openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" '
                'Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>'
                '</Relationships>\n')
-    z.writestr("3D/3dmodel.model", model_xml([box((0, 0, 0), (20, 10, 10)), box((10, 5, 5), (30, 15, 15))]))
+    z.writestr(entry("3D/3dmodel.model"), model_xml([box((0, 0, 0), (20, 10, 10)), box((10, 5, 5), (30, 15, 15))]))
 
 rng = np.random.default_rng(7)
 p = rng.normal(size=(4000, 3))
@@ -114,5 +119,5 @@ t = np.linspace(0, 2 * math.pi, 120, endpoint=False)
 bore = np.c_[3 * np.cos(t), 3 * np.sin(t)]
 np.savetxt("cam.xy", np.r_[outer, bore], fmt="%.4f")
 
-z = np.linspace(0.2, 0.35, 3)
+z = np.linspace(0.25, 0.4, 3)
 np.save("grade.npy", np.broadcast_to(z, (3, 3, 3)).astype(np.float64).copy())
