@@ -34,8 +34,8 @@
 //! Run: `cargo bench --bench peers` (`-- --runs N --res 32,64 --cells N --large N`).
 
 use latvox::field::{Field, Intersection};
+use latvox::geom::Mesh;
 use latvox::grid::GridSpec;
-use latvox::mesh::Mesh;
 use latvox::tpms::{calibrate, Domain, Lattice, Structure, Surface, TpmsJob, HALF_WIDTH};
 use rayon::prelude::*;
 use serde_json::{json, Value};

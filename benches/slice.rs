@@ -175,7 +175,7 @@ fn main() {
     // Without a mesh: the filled cube's part file sliced to 1,000 masks; then meshed and sliced.
     let cube: Vec<u8> = {
         let (lo, hi) = ([0.0f32; 3], [50.0f32; 3]);
-        let m = latvox::mesh::Mesh::cuboid(lo, hi);
+        let m = latvox::geom::Mesh::cuboid(lo, hi);
         let mut b = vec![0u8; 80];
         b.extend((m.triangle_count() as u32).to_le_bytes());
         for t in m.indices.chunks_exact(3) {

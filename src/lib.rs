@@ -61,6 +61,7 @@ pub(crate) mod ffi;
 pub mod fgm;
 pub mod field;
 pub mod fill;
+pub mod geom;
 pub mod grid;
 pub mod interpret;
 pub mod io;

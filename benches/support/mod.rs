@@ -3,8 +3,8 @@
 //! a torus mesh, latvox as a quiet child process, medians and the `--runs` argument.
 #![allow(dead_code)]
 
+use latvox::geom::Mesh;
 use latvox::io::sink::{MeshSink, Triangle};
-use latvox::mesh::Mesh;
 use std::f64::consts::PI;
 
 /// The process's peak resident memory, MB (`VmHWM`).

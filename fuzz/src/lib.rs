@@ -1,17 +1,18 @@
-//! latvox's mesh readers, compiled from latvox's own source files for fuzzing. Only the modules
-//! the readers need are included (errors, fields, the mesh type, polygon triangulation, io), so
-//! the fuzz build never compiles the C++ bridges. `check` holds the invariants every target
+//! latvox's mesh readers, compiled from latvox's own source files for fuzzing. Only the stages
+//! the readers need are included (errors, geometry, io, fields), so the fuzz build never
+//! compiles the C++ bridges. `check` holds the invariants every target
 //! asserts on a successful parse.
 #![allow(dead_code, unused_imports)]
 
 #[path = "../../src/error.rs"]
 pub mod error;
+#[path = "../../src/geom/mod.rs"]
+pub mod geom;
 #[path = "../../src/field/mod.rs"]
 pub mod field;
 #[path = "../../src/io/mod.rs"]
 pub mod io;
 
-pub mod mesh;
 
 pub use error::{Error, Result};
 

@@ -6,7 +6,7 @@ use crate::check::Verdict;
 use crate::error::Result;
 use crate::ffi::cgal::ffi;
 use crate::ffi::Backend;
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 
 /// What CGAL found.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]

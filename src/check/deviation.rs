@@ -10,7 +10,7 @@
 use crate::error::Result;
 use crate::ffi::cgal::ffi;
 use crate::ffi::Backend;
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 
 /// Distances from one mesh's vertices to another's facets, mm.
 #[derive(Debug, Clone, Copy, Default, serde::Serialize)]

@@ -4,8 +4,8 @@
 use super::{check, CheckOptions, CheckReport, Verdict};
 use crate::check::cgal::Verification;
 use crate::error::Result;
+use crate::geom::EdgeStats;
 use crate::io::{Format, Loaded, ReadOptions, Reading};
-use crate::mesh::EdgeStats;
 use crate::progress::Progress;
 use std::path::Path;
 
@@ -40,7 +40,7 @@ pub struct FileCheckReport {
     pub triangles: u64,
     /// Vertices after welding.
     pub vertices: u64,
-    /// The edge counts of the check, in the shape of [`crate::mesh::Mesh::edge_stats`].
+    /// The edge counts of the check, in the shape of [`crate::geom::Mesh::edge_stats`].
     pub edges: EdgeStats,
     /// What reading did to the file (faces skipped, polygons split, vertices merged).
     pub reading: Reading,

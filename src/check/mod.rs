@@ -24,8 +24,8 @@ pub use verdict::Verdict;
 
 use crate::error::Result;
 use crate::field::Vec3;
-use crate::mesh::topology::{half_edge, Shells, Topology};
-use crate::mesh::{cross, dot, norm, signed_volume, sub, Mesh};
+use crate::geom::topology::{half_edge, Shells, Topology};
+use crate::geom::{cross, dot, norm, signed_volume, sub, Mesh};
 use rayon::prelude::*;
 
 /// A facet whose area is below this fraction of its longest edge squared is degenerate

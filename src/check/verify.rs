@@ -9,9 +9,9 @@ use crate::check::cgal::Verification;
 use crate::check::self_intersect::fans::{fan, Links};
 use crate::check::self_intersect::{soup_self_intersections_shown, Stars};
 use crate::error::Result;
-use crate::mesh::topology::UnionFind;
-use crate::mesh::Mesh;
-use crate::mesh::{cross, norm, ordered_sum, signed_volume, sub};
+use crate::geom::topology::UnionFind;
+use crate::geom::Mesh;
+use crate::geom::{cross, norm, ordered_sum, signed_volume, sub};
 use crate::progress::Progress;
 use rayon::prelude::*;
 
@@ -79,7 +79,7 @@ pub fn verify(mesh: &Mesh, how: Verify, progress: &Progress) -> Result<Verificat
                 || {
                     let all: Vec<u32> = (0..mesh.triangle_count() as u32)
                         .into_par_iter()
-                        .filter(|&f| !crate::mesh::topology::repeats_vertex(mesh, f as usize))
+                        .filter(|&f| !crate::geom::topology::repeats_vertex(mesh, f as usize))
                         .collect();
                     soup_self_intersections_shown(mesh, &all, 0, stars, progress).0
                 },
@@ -183,7 +183,7 @@ fn vertex_fans(mesh: &Mesh, stars: bool) -> VertexFans {
     let nv = mesh.vertex_count();
     let repeated = (0..mesh.triangle_count())
         .into_par_iter()
-        .any(|f| crate::mesh::topology::repeats_vertex(mesh, f));
+        .any(|f| crate::geom::topology::repeats_vertex(mesh, f));
     let links = Links::new(nv, &mesh.indices, stars.then_some(&mesh.positions[..]));
     const CHUNK: usize = 4096;
     let mut star = vec![false; if stars { nv } else { 0 }];

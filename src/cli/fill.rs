@@ -157,7 +157,7 @@ pub struct FillArgs {
 }
 
 /// Reads a mesh file for the job, naming it in errors.
-fn read(path: &Path) -> Result<(String, latvox::mesh::Mesh)> {
+fn read(path: &Path) -> Result<(String, latvox::geom::Mesh)> {
     let loaded = latvox::mesh::part::read(path, &ReadOptions::default())?;
     Ok((path.display().to_string(), loaded.mesh))
 }

@@ -10,7 +10,7 @@
 
 use crate::error::{Error, Result};
 use crate::field::Vec3;
-use crate::render::bvh::Bvh;
+use crate::geom::bvh::Bvh;
 use std::path::Path;
 
 /// What the composition is graded from.

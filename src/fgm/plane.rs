@@ -8,7 +8,7 @@
 //! `(x₀ + i·h, y₀ + j·h)` of a square grid, as the implicit FGM literature computes the signed
 //! distance at the vertices of a uniformly subdivided box (its example: a cam's profile in a
 //! 20 × 20 grid). The outline is the zero iso-line by marching squares
-//! ([`crate::slice::contour::iso_loops`]).
+//! ([`crate::geom::contour::iso_loops`]).
 
 use super::cloud::Cloud;
 use super::geometry::ScanSdf;
@@ -16,10 +16,10 @@ use super::job::{choose_dmax, mix, FgmJob, Geometry, GeometryReport};
 use super::material::Composition;
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Field};
+use crate::geom::contour::{iso_loops, signed_area, Loop};
 use crate::grid::GridSpec;
 use crate::mesh::pipeline::HALF_WIDTH;
 use crate::progress::Progress;
-use crate::slice::contour::{iso_loops, signed_area, Loop};
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::Path;

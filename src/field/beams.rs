@@ -11,18 +11,7 @@
 //! the value is the reach, so a sample looks at a few pieces, not all.
 
 use super::{Aabb, Field, Vec3};
-
-/// How a beam end is closed (the Beam Lattice extension's cap modes).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Cap {
-    /// A sphere of the end's radius around the end point.
-    #[default]
-    Sphere,
-    /// The half of that sphere beyond the end.
-    Hemisphere,
-    /// A flat end.
-    Butt,
-}
+pub use crate::io::threemf::Cap;
 
 /// A piece of the solid.
 #[derive(Debug, Clone, Copy)]

@@ -849,7 +849,7 @@ mod tests {
         assert!((t.value([1.0 + 11.0, -2.0, 19.0]) - 1.0f64.hypot(4.0)).abs() < 1e-12);
         // A box from the axis out: its volume within radius 2 is a disc's (π·2²·h) when the
         // box's half width is over 2.
-        let mesh = crate::mesh::Mesh::cuboid([-3.0, -4.0, 0.0], [4.0, 3.0, 2.0]);
+        let mesh = crate::geom::Mesh::cuboid([-3.0, -4.0, 0.0], [4.0, 3.0, 2.0]);
         let tris = (0..mesh.triangle_count()).map(|i| mesh.triangle(i));
         let t0 = Cylindrical::new([0.0, 0.0, 0.0], 1.0, [3, 1, 1], [1.0, 1.0]).unwrap();
         let v = t0.volume_within(tris, 2.0);
@@ -907,7 +907,7 @@ mod tests {
         // A cube of half side 5 about the centre holds the whole ball of radius 4 and a part of
         // the ball of radius 6 (the ball less six caps of height 1).
         let s = Spherical::new([0.0; 3], 1.0, [2, 1], None).unwrap();
-        let mesh = crate::mesh::Mesh::cuboid([-5.0; 3], [5.0; 3]);
+        let mesh = crate::geom::Mesh::cuboid([-5.0; 3], [5.0; 3]);
         let within = |r: f64| {
             let mut tris = (0..mesh.triangle_count()).map(|i| mesh.triangle(i));
             Layered::volume_within(&s, &mut tris, r)

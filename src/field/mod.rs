@@ -16,8 +16,7 @@ pub mod sizing;
 
 pub use domain::Domain;
 
-/// A point or vector in millimetres.
-pub type Vec3 = [f64; 3];
+pub use crate::geom::{Aabb, Vec3};
 
 /// An implicit solid: `value < 0` inside.
 pub trait Field: Sync {
@@ -132,50 +131,6 @@ pub fn intersection_clearance(a: f64, ca: f64, b: f64, cb: f64) -> f64 {
 /// inside either operand, that operand's clearance alone is a valid bound.
 pub fn union_clearance(a: f64, ca: f64, b: f64, cb: f64) -> f64 {
     intersection_clearance(-a, ca, -b, cb)
-}
-
-/// An axis-aligned box `[min, max]`, as an exact signed distance field.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct Aabb {
-    /// Lower corner, mm.
-    pub min: Vec3,
-    /// Upper corner, mm.
-    pub max: Vec3,
-}
-
-impl Aabb {
-    /// Edge lengths along x, y, z, mm.
-    pub fn size(&self) -> Vec3 {
-        [
-            self.max[0] - self.min[0],
-            self.max[1] - self.min[1],
-            self.max[2] - self.min[2],
-        ]
-    }
-
-    /// Volume, mm³.
-    pub fn volume(&self) -> f64 {
-        let s = self.size();
-        s[0] * s[1] * s[2]
-    }
-
-    /// The centre, mm.
-    pub fn centre(&self) -> Vec3 {
-        [0, 1, 2].map(|a| 0.5 * (self.min[a] + self.max[a]))
-    }
-
-    /// Whether `p` lies in the box (faces included).
-    pub fn contains(&self, p: Vec3) -> bool {
-        (0..3).all(|a| p[a] >= self.min[a] && p[a] <= self.max[a])
-    }
-
-    /// The box grown by `m` on every side.
-    pub fn grown(&self, m: f64) -> Aabb {
-        Aabb {
-            min: self.min.map(|x| x - m),
-            max: self.max.map(|x| x + m),
-        }
-    }
 }
 
 impl Field for Aabb {

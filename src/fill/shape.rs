@@ -24,9 +24,9 @@
 
 use crate::error::Result;
 use crate::field::{intersection_clearance, smooth_min, union_clearance, Aabb, Field, Vec3};
+use crate::geom::Mesh;
 use crate::grid::{distance_clearance, Grid, GridSpec, SPARE_VOXELS};
 use crate::mesh::pipeline::{Family, Solid, HALF_WIDTH};
-use crate::mesh::Mesh;
 use std::sync::Arc;
 
 /// The part and the solids kept whole, as distance grids on one voxel size.
@@ -60,7 +60,7 @@ pub struct Drain {
 impl Drain {
     /// Signed distance to the hole (negative inside).
     pub(crate) fn distance(&self, p: Vec3) -> f64 {
-        use crate::mesh::{dot, sub};
+        use crate::geom::{dot, sub};
         let (ab, ap) = (sub(self.to, self.from), sub(p, self.from));
         let t = (dot(ap, ab) / dot(ab, ab)).clamp(0.0, 1.0);
         let q = [0, 1, 2].map(|a| ap[a] - t * ab[a]);
@@ -70,7 +70,7 @@ impl Drain {
     /// Holes of `diameter` reaching `depth` and half a hole into `part`: at its lowest and
     /// highest facet along z, along their inward normals.
     pub fn at_ends(part: &Mesh, diameter: f64, depth: f64) -> Vec<Drain> {
-        use crate::mesh::{cross, norm, sub};
+        use crate::geom::{cross, norm, sub};
         let tris: Vec<[Vec3; 3]> = (0..part.triangle_count())
             .map(|t| {
                 [0, 1, 2].map(|k| {

@@ -11,9 +11,9 @@ use super::job::{closed, FillJob, Infilling};
 use super::shape::{skin_or_lattice, Drain};
 use crate::error::Result;
 use crate::field::{intersection_clearance, union_clearance, Aabb, Field, Vec3};
+use crate::geom::bvh::Bvh;
+use crate::geom::{norm, sub};
 use crate::grid::GridSpec;
-use crate::mesh::{norm, sub};
-use crate::render::bvh::Bvh;
 use crate::render::camera::{dot, Ray};
 use crate::render::trace::{
     field_normal, field_openness, mesh_hit, sphere_trace, Hit, Scene, Section, Tolerance,

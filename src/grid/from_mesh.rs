@@ -4,7 +4,7 @@ use super::{Grid, GridSpec};
 use crate::error::Result;
 use crate::ffi::vdb::ffi;
 use crate::ffi::Backend;
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 
 impl Grid {
     /// The level set of a triangle mesh at `voxel` mm, by OpenVDB's meshToLevelSet: a signed
@@ -59,7 +59,7 @@ impl Grid {
     /// (csgDifference), and the shells facing out that lie inside a void (islands) are added
     /// back (csgUnion). A void inside an island inside a void is filled.
     pub fn of_solid(mesh: &Mesh, voxel: f64, half_width: f64) -> Result<Grid> {
-        use crate::mesh::topology::{Shells, Topology};
+        use crate::geom::topology::{Shells, Topology};
         let shells = Shells::new(mesh, &Topology::new(mesh));
         let corner = |i: u32| {
             let i = 3 * i as usize;
@@ -70,7 +70,7 @@ impl Grid {
             s.iter()
                 .map(|&f| {
                     let t = facets(f);
-                    crate::mesh::signed_volume(corner(t[0]), corner(t[1]), corner(t[2]))
+                    crate::geom::signed_volume(corner(t[0]), corner(t[1]), corner(t[2]))
                 })
                 .sum()
         };

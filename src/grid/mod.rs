@@ -151,7 +151,7 @@ impl Grid {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::Mesh;
+    use crate::geom::Mesh;
 
     const BOX: Aabb = Aabb {
         min: [0.0; 3],

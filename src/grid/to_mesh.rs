@@ -4,7 +4,7 @@ use super::Grid;
 use crate::error::Result;
 use crate::ffi::vdb::ffi;
 use crate::ffi::Backend;
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 
 const MESHING: &str = "meshing the level set (OpenVDB volumeToMesh)";
 

@@ -7,7 +7,7 @@
 
 use super::raster::Raster;
 
-pub use crate::slice::contour::{contains, iso_loops, polygons, signed_area, Loop};
+pub use crate::geom::contour::{contains, iso_loops, polygons, signed_area, Loop};
 
 /// Loops of `{f ≥ level}`, with the field's pixel `(i, j)` centred at `((i + ½)h, (j + ½)h)`;
 /// beyond the raster counts as 0 (void).

@@ -4,7 +4,7 @@
 
 use super::contour::{polygons, Loop};
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 
 /// Extrudes `loops` (outer counter-clockwise, holes clockwise) from z = 0 to z = `thickness`.
 pub fn extrude(loops: &[Loop], thickness: f64) -> Result<Mesh> {
@@ -61,7 +61,7 @@ pub fn extrude(loops: &[Loop], thickness: f64) -> Result<Mesh> {
     let mut ec = earcut::Earcut::new();
     let mut refiner = earcut::Refiner::new();
     let mut tris: Vec<u32> = Vec::new();
-    for crate::slice::contour::Polygon { outer, holes } in polygons(loops) {
+    for crate::geom::contour::Polygon { outer, holes } in polygons(loops) {
         let mut data: Vec<[f64; 2]> = loops[outer].clone();
         let mut map: Vec<u32> = (0..loops[outer].len())
             .map(|k| (starts[outer] + k) as u32)

@@ -11,8 +11,8 @@
 use super::raster::Raster;
 use crate::error::Result;
 use crate::field::{Aabb, Field, Intersection, Vec3};
+use crate::geom::Mesh;
 use crate::grid::{Grid, GridSpec, Smoothing};
-use crate::mesh::Mesh;
 
 /// The iso-surface `ρ = level` of a 3D raster.
 pub struct DensityField<'a> {

@@ -22,7 +22,7 @@ pub mod threemf;
 pub mod weld;
 
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 use std::path::Path;
 
 pub use stl::StlFormat;
@@ -310,7 +310,7 @@ impl PolygonSink {
                         [0, 1, 2].map(|a| self.positions[i + a] as f64)
                     })
                     .collect();
-                match crate::mesh::triangulate::triangulate_polygon(&pts) {
+                match crate::geom::triangulate::triangulate_polygon(&pts) {
                     Some(tris) => {
                         for t in tris {
                             self.indices.extend(t.map(|k| c[k]));

@@ -4,7 +4,7 @@
 
 use super::{Parsed, PolygonSink};
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 use std::io::Write;
 
 /// Parses OBJ bytes (any line ends; non-UTF-8 bytes in ignored lines are harmless).

@@ -5,7 +5,7 @@
 
 use super::{Parsed, PolygonSink};
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 use std::io::Write;
 
 /// Whether `head` (the first bytes of a file) starts with an OFF keyword.

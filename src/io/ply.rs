@@ -6,7 +6,7 @@
 
 use super::{Parsed, PolygonSink, Words};
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 use std::io::Write;
 
 #[derive(Debug, Clone, Copy, PartialEq)]

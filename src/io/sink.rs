@@ -10,10 +10,10 @@
 //! them by the output's extension.
 
 use crate::error::{Error, Result};
-use crate::field::Aabb;
+use crate::geom::Aabb;
+use crate::geom::Mesh;
 use crate::io::stl::StlFormat;
 use crate::io::weld::ExactIndex;
-use crate::mesh::Mesh;
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -76,7 +76,7 @@ impl Measures {
     }
 
     fn add(&mut self, t: &Triangle) {
-        use crate::mesh::{cross, norm, signed_volume, sub};
+        use crate::geom::{cross, norm, signed_volume, sub};
         let p = t.map(|v| v.map(|x| x as f64));
         self.triangles += 1;
         self.volume += signed_volume(p[0], p[1], p[2]);
@@ -184,7 +184,7 @@ impl StlSink {
 }
 
 fn unit_normal(t: &Triangle) -> [f32; 3] {
-    use crate::mesh::{cross, norm, sub};
+    use crate::geom::{cross, norm, sub};
     let p = t.map(|v| v.map(|x| x as f64));
     let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
     let l = norm(n);

@@ -6,7 +6,7 @@
 use super::weld::ExactWelder;
 use super::{Parsed, Words};
 use crate::error::{Error, Result};
-use crate::mesh::{cross, norm, sub, Mesh};
+use crate::geom::{cross, norm, sub, Mesh};
 use std::io::Write;
 use std::path::Path;
 

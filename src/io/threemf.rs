@@ -9,11 +9,22 @@
 
 use super::{Parsed, PolygonSink};
 use crate::error::{Error, Result};
-pub use crate::field::beams::Cap;
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 use quick_xml::events::{BytesStart, Event};
 use std::collections::HashMap;
 use std::io::{Cursor, Read, Write};
+
+/// How a beam end is closed (the Beam Lattice extension's cap modes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Cap {
+    /// A sphere of the end's radius around the end point.
+    #[default]
+    Sphere,
+    /// The half of that sphere beyond the end.
+    Hemisphere,
+    /// A flat end.
+    Butt,
+}
 
 const MODEL_NS: &str = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02";
 const REL_3DMODEL: &str = "http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel";
@@ -928,7 +939,7 @@ pub struct BeamModel {
     /// Beams shorter than this are not written (the extension's `minlength`), mm.
     pub min_length: f64,
     /// The box that clips the beams, if any.
-    pub clip: Option<crate::field::Aabb>,
+    pub clip: Option<crate::geom::Aabb>,
     /// Per beam, the index of its set in `set_names`.
     pub sets: Vec<u32>,
     /// The names of the beam sets.

@@ -9,7 +9,7 @@
 //! depend on hash order.
 
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 use std::collections::HashMap;
 use std::hash::{BuildHasher, Hasher};
 

@@ -8,9 +8,9 @@
 //! reaches, and its plain flux `∫ n_z dA` times their height to the cells wholly below it —
 //! summed per column from the top once every triangle is in.
 
-use super::indexed::clipped_column_integral;
 use crate::error::Result;
 use crate::field::{Aabb, Vec3};
+use crate::geom::clipped_column_integral;
 use crate::io::sink::{MeshSink, Triangle};
 
 /// Per-cell volumes of a mesh over a part's box cut into cells (partial at the far sides).
@@ -193,7 +193,7 @@ impl CellVolumes {
     }
 
     /// Adds the triangles of an in-memory mesh, in parallel.
-    pub fn add_mesh(&mut self, mesh: &super::Mesh) {
+    pub fn add_mesh(&mut self, mesh: &crate::geom::Mesh) {
         use rayon::prelude::*;
         let empty = CellVolumes::new(self.bounds, self.cell);
         const CHUNK: usize = 1 << 15;
@@ -213,7 +213,7 @@ impl CellVolumes {
     }
 
     /// The per-cell volumes of an in-memory mesh.
-    pub fn of_mesh(mesh: &super::Mesh, bounds: Aabb, cell: Vec3) -> CellVolumes {
+    pub fn of_mesh(mesh: &crate::geom::Mesh, bounds: Aabb, cell: Vec3) -> CellVolumes {
         let mut v = CellVolumes::new(bounds, cell);
         v.add_mesh(mesh);
         v
@@ -275,7 +275,7 @@ mod tests {
             ([0.5, 0.25, 0.2], [2.5, 1.5, 2.9]),
             ([0.5, 0.0, 1.0], [2.5, 2.0, 2.0]),
         ] {
-            let mesh = crate::mesh::Mesh::cuboid(lo, hi);
+            let mesh = crate::geom::Mesh::cuboid(lo, hi);
             let cells = CellVolumes::of_mesh(&mesh, part, [1.0; 3]);
             assert_eq!(cells.counts, [3, 2, 3]);
             let v = cells.volumes();

@@ -13,8 +13,8 @@
 //! belongs to exactly one piece (the one holding its edge's lower sample).
 
 use crate::error::Result;
+use crate::geom::Mesh;
 use crate::grid::{Grid, GridSpec};
-use crate::mesh::Mesh;
 use rayon::prelude::*;
 
 /// A vertex of an extracted mesh: the voxel it lies in (by its lower-corner sample index) and
@@ -193,7 +193,7 @@ impl KeyedMesh {
 /// Shape quality of a triangle: twice its area over the sum of its squared edge lengths (0 for a
 /// sliver, largest for an equilateral triangle).
 fn quality(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
-    use crate::mesh::{cross, dot, norm, sub};
+    use crate::geom::{cross, dot, norm, sub};
     let (ab, bc, ca) = (sub(b, a), sub(c, b), sub(a, c));
     let s = dot(ab, ab) + dot(bc, bc) + dot(ca, ca);
     if s > 0.0 {

@@ -348,7 +348,7 @@ impl Template {
     /// `d · n / 3` to the divergence-theorem volume (`n` its area vector), so per kind the sum of
     /// the triangles' volumes and of their area vectors is enough.
     pub fn part_volume(&self) -> f64 {
-        use crate::mesh::{cross, dot, signed_volume, sub};
+        use crate::geom::{cross, dot, signed_volume, sub};
         let pos = |v: u32| self.mesh.positions[v as usize].map(|x| x as f32 as f64);
         let per_kind: Vec<(f64, Vec3)> = self
             .quads_by_cell

@@ -1,19 +1,18 @@
-//! Meshes: the triangle mesh and what makes one from a grid and gets it out.
+//! Meshing: what makes a mesh from a grid and gets it out (the mesh type is
+//! [`crate::geom::Mesh`]).
 //!
-//! `indexed` is the mesh type and its measures; [`extract`] meshes a level set with every
+//! [`extract`] meshes a level set with every
 //! vertex named by its voxel and edge group, [`snap`] moves the vertices onto the exact surface,
 //! [`tile`] and [`instance`] mesh large parts in pieces that weld exactly, [`pieces`] finds the
 //! fragments a box cuts loose, and [`pipeline`] puts them together: any clipped field to a
 //! verified mesh at its target density, streamed to a sink, at the resolution [`resolution`]
 //! finds it needs,
 //! reported the same way for every capability ([`report`]) and written where [`output`] says; [`graded`] meets a density that
-//! varies through the part, cell by cell ([`cells`] measures them). [`topology`] and [`triangulate`]
-//! serve the checks and the readers.
+//! varies through the part, cell by cell ([`cells`] measures them).
 
 pub mod cells;
 pub mod extract;
 pub mod graded;
-mod indexed;
 pub mod instance;
 pub mod output;
 pub mod part;
@@ -23,7 +22,3 @@ pub mod report;
 pub mod resolution;
 pub mod snap;
 pub mod tile;
-pub mod topology;
-pub mod triangulate;
-
-pub use indexed::*;

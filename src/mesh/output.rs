@@ -3,8 +3,8 @@
 //! narrow-band level set (the solid the mesh as written bounds, voids kept: `Grid::of_solid`),
 //! a grid named `sdf` that OpenVDB's tools (`vdb_print`, `vdb_view`) and its Python module read.
 
-use super::Mesh;
 use crate::error::{Error, Result};
+use crate::geom::Mesh;
 use crate::io::sink::{MeshCollector, MeshSink, StlSink, ThreeMfSink, Triangle};
 use crate::io::{Format, StlFormat};
 use std::path::{Path, PathBuf};
@@ -133,7 +133,7 @@ fn mean_edge(mesh: &Mesh) -> Option<f64> {
     for t in mesh.indices.chunks_exact(3) {
         for k in 0..3 {
             let (a, b) = (p(t[k]), p(t[(k + 1) % 3]));
-            sum += crate::mesh::norm(crate::mesh::sub(a, b));
+            sum += crate::geom::norm(crate::geom::sub(a, b));
             n += 1;
         }
     }

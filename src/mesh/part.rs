@@ -17,11 +17,11 @@
 use crate::error::{Error, Result};
 use crate::field::beams::{Beam, BeamField};
 use crate::field::{intersection_clearance, union_clearance, Aabb, Field, Vec3};
+use crate::geom::Mesh;
 use crate::grid::{distance_clearance, Grid, GridSpec, SPARE_VOXELS};
 use crate::io::threemf::{BeamLattice, Clipping};
 use crate::io::{BeamsMeshed, Loaded, ReadOptions};
 use crate::mesh::pipeline::{mesh_keyed, part_spec, Solid, HALF_WIDTH};
-use crate::mesh::Mesh;
 use std::path::Path;
 
 /// The default voxel: this fraction of the thinnest radius (twelve voxels across the thinnest

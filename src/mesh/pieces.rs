@@ -9,9 +9,9 @@
 //! its bounds, is a fragment.
 
 use crate::field::Aabb;
+use crate::geom::signed_volume;
+use crate::geom::topology::UnionFind;
 use crate::mesh::extract::KeyedMesh;
-use crate::mesh::signed_volume;
-use crate::mesh::topology::UnionFind;
 
 /// Fragments found (and removed, unless kept) in a mesh.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]

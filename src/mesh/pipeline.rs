@@ -25,6 +25,7 @@ use crate::check::cgal::Verification;
 use crate::check::verify::{verify, Verify};
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Field, Intersection, Vec3};
+use crate::geom::Mesh;
 use crate::grid::{Grid, GridSpec, IndexBox};
 use crate::io::sink::{Measures, MeshSink, Triangle};
 use crate::mesh::extract::KeyedMesh;
@@ -32,7 +33,6 @@ use crate::mesh::instance::{self, AxisPlan, Template};
 use crate::mesh::pieces::{self, Fragments};
 use crate::mesh::snap::SnapStats;
 use crate::mesh::tile;
-use crate::mesh::Mesh;
 use crate::progress::Progress;
 use std::time::Instant;
 
@@ -392,9 +392,9 @@ pub fn solid_volume<S: Solid>(solid: &S, voxel: f64, route: Route) -> Result<(f6
 
 /// Enclosed volume of a keyed mesh as it is written (single-precision corners), mm³.
 pub fn keyed_volume(mesh: &KeyedMesh) -> f64 {
-    use crate::mesh::signed_volume;
+    use crate::geom::signed_volume;
     let tris: Vec<[u32; 3]> = mesh.triangles().collect();
-    crate::mesh::ordered_sum(tris.len(), |i| {
+    crate::geom::ordered_sum(tris.len(), |i| {
         let [a, b, c] = tris[i].map(|v| mesh.positions[v as usize].map(|x| x as f32 as f64));
         signed_volume(a, b, c)
     })

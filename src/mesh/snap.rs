@@ -113,7 +113,7 @@ pub fn snap_within(
 /// [`MAX_TURN_DEGREES`]; repeats until no triangle is turned, for at most [`UNFOLD_PASSES`] passes.
 /// Returns how many were restored.
 pub fn unfold(mesh: &mut KeyedMesh, spec: &GridSpec) -> u64 {
-    use crate::mesh::{cross, dot, norm, sub};
+    use crate::geom::{cross, dot, norm, sub};
     let cos_max = MAX_TURN_DEGREES.to_radians().cos();
     let original = |m: &KeyedMesh, v: u32| {
         let v = v as usize;
@@ -157,7 +157,7 @@ pub fn unfold(mesh: &mut KeyedMesh, spec: &GridSpec) -> u64 {
 /// most [`UNFOLD_PASSES`] passes. Returns how many were restored.
 fn untangle(mesh: &mut KeyedMesh, clip: &Aabb, spec: &GridSpec) -> u64 {
     use crate::check::self_intersect::exact::{facets_intersect, Facet};
-    use crate::mesh::{cross, norm, sub};
+    use crate::geom::{cross, norm, sub};
     use std::collections::HashMap;
     let on_clip = |p: Vec3| (0..3).any(|a| p[a] == clip.min[a] || p[a] == clip.max[a]);
     // The vertices in voxels holding more than one: two sheets pass through those.

@@ -24,11 +24,11 @@
 use crate::check::verify::Verify;
 use crate::error::Result;
 use crate::field::Aabb;
+use crate::geom::topology::UnionFind;
 use crate::grid::IndexBox;
 use crate::io::sink::{Measures, MeshSink, Triangle};
 use crate::mesh::extract::{KeyedMesh, VertexKey};
 use crate::mesh::pieces::{self, Fragments, Shells};
-use crate::mesh::topology::UnionFind;
 use crate::progress::Progress;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -439,7 +439,7 @@ fn tile_result(
         let around = (0..mesh.quads.len())
             .filter(|&q| !inside(mesh.edges[q], 0) && inside(mesh.edges[q], 3));
         let mut index = vec![u32::MAX; n];
-        let mut patch = crate::mesh::Mesh::default();
+        let mut patch = crate::geom::Mesh::default();
         let mut kept_triangles = 0;
         for (i, q) in kept.iter().copied().chain(around).enumerate() {
             for t in tris_of(q) {

@@ -4,8 +4,9 @@
 //! front (the eye on −y looking along +y, azimuth 0°) towards the right side (the eye on +x,
 //! azimuth 90°); the elevation lifts it above the xy plane (90°: looking straight down).
 
-use crate::field::{Aabb, Vec3};
-pub(crate) use crate::mesh::{cross, dot, norm};
+pub use crate::geom::Ray;
+pub(crate) use crate::geom::{cross, dot, normalized};
+use crate::geom::{Aabb, Vec3};
 
 /// A named view: the azimuth and elevation it stands for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -39,50 +40,6 @@ impl View {
             View::Top => (0.0, 90.0),
             View::Bottom => (0.0, -90.0),
         }
-    }
-}
-
-/// A ray: `origin + t·dir`, `dir` of unit length.
-#[derive(Debug, Clone, Copy)]
-pub struct Ray {
-    /// Where it starts, mm.
-    pub origin: Vec3,
-    /// Its direction, unit length.
-    pub dir: Vec3,
-}
-
-impl Ray {
-    /// The point at distance `t`.
-    #[inline]
-    pub fn at(&self, t: f64) -> Vec3 {
-        [
-            self.origin[0] + t * self.dir[0],
-            self.origin[1] + t * self.dir[1],
-            self.origin[2] + t * self.dir[2],
-        ]
-    }
-
-    /// The part of the ray inside `b`, as `(t_enter, t_exit)` with `t_enter ≥ 0`, if any.
-    pub fn clip(&self, b: &Aabb) -> Option<(f64, f64)> {
-        let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
-        for a in 0..3 {
-            let inv = 1.0 / self.dir[a];
-            let (mut lo, mut hi) = (
-                (b.min[a] - self.origin[a]) * inv,
-                (b.max[a] - self.origin[a]) * inv,
-            );
-            if lo > hi {
-                std::mem::swap(&mut lo, &mut hi);
-            }
-            // NaN (a ray in the plane of a face) keeps the other bounds.
-            if lo > t0 {
-                t0 = lo;
-            }
-            if hi < t1 {
-                t1 = hi;
-            }
-        }
-        (t0 <= t1).then_some((t0, t1))
     }
 }
 
@@ -170,16 +127,6 @@ impl Camera {
     /// The width of one pixel at distance `t` from the eye, mm.
     pub fn pixel_at(&self, t: f64) -> f64 {
         2.0 * t * (0.5 * self.fov).to_radians().tan() / self.height as f64
-    }
-}
-
-/// `a` scaled to unit length (unchanged if zero).
-pub(crate) fn normalized(a: Vec3) -> Vec3 {
-    let n = norm(a);
-    if n > 0.0 {
-        a.map(|x| x / n)
-    } else {
-        a
     }
 }
 

@@ -6,7 +6,6 @@
 //! memory is the image and the scene's own (a unit cell's struts, a mesh's BVH), whatever the
 //! number of cells.
 
-pub mod bvh;
 pub mod camera;
 pub mod trace;
 pub mod view;

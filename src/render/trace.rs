@@ -14,9 +14,9 @@
 //! cell boundary gives in Guo and Li's augmented sphere tracing, without the extra stop). No
 //! step can therefore tunnel through a strut or sheet thicker than the tolerance.
 
-use super::bvh::Bvh;
 use super::camera::{dot, Ray};
 use crate::field::{intersection_clearance, Aabb, Field, Vec3};
+use crate::geom::bvh::Bvh;
 
 /// Where a ray meets the scene.
 #[derive(Debug, Clone, Copy)]

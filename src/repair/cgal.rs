@@ -4,7 +4,7 @@
 use crate::error::Result;
 use crate::ffi::cgal::ffi;
 use crate::ffi::Backend;
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 
 /// What CGAL added to fill holes.
 pub struct Filled {

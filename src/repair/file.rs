@@ -5,9 +5,9 @@ use super::{repair, RepairOptions, RepairReport};
 use crate::check::deviation::{deviation, Deviation};
 use crate::check::{check, read_file, CheckOptions, CheckReport, Defects, Verdict};
 use crate::error::{Error, Result};
+use crate::geom::Mesh;
 use crate::io::{Format, ReadOptions, Reading};
 use crate::mesh::output::MeshFile;
-use crate::mesh::Mesh;
 use crate::progress::Progress;
 use std::path::Path;
 

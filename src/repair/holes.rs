@@ -7,9 +7,9 @@
 use super::cgal;
 use crate::error::Result;
 use crate::field::Vec3;
-use crate::mesh::topology::BoundaryLoop;
-use crate::mesh::triangulate::{newell_normal, triangulate_polygon};
-use crate::mesh::{dot, norm, sub, Mesh};
+use crate::geom::topology::BoundaryLoop;
+use crate::geom::triangulate::{newell_normal, triangulate_polygon};
+use crate::geom::{dot, norm, sub, Mesh};
 
 /// A loop is planar when no vertex is farther than this fraction of its bounding-box diagonal
 /// from its best plane.
@@ -117,14 +117,14 @@ pub fn is_flat(mesh: &Mesh, members: &[u32]) -> bool {
     let Some(&big) = members.iter().max_by(|&&a, &&b| {
         let area = |f: u32| {
             let [p, q, r] = mesh.triangle(f as usize);
-            norm(crate::mesh::cross(sub(q, p), sub(r, p)))
+            norm(crate::geom::cross(sub(q, p), sub(r, p)))
         };
         area(a).total_cmp(&area(b))
     }) else {
         return false;
     };
     let [p, q, r] = mesh.triangle(big as usize);
-    let n = crate::mesh::cross(sub(q, p), sub(r, p));
+    let n = crate::geom::cross(sub(q, p), sub(r, p));
     let ln = norm(n);
     if ln == 0.0 {
         return false;

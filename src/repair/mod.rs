@@ -26,8 +26,8 @@ mod split;
 
 use crate::check;
 use crate::error::Result;
-use crate::mesh::topology::{BoundaryLoop, Shells, Topology};
-use crate::mesh::{signed_volume, sub, Mesh};
+use crate::geom::topology::{BoundaryLoop, Shells, Topology};
+use crate::geom::{signed_volume, sub, Mesh};
 use crate::progress::Progress;
 
 pub use file::{repair_file, FileRepairReport};
@@ -318,7 +318,7 @@ pub fn repair(
     let diag = w
         .mesh
         .bounds()
-        .map(|b| crate::mesh::norm(sub(b.max, b.min)))
+        .map(|b| crate::geom::norm(sub(b.max, b.min)))
         .unwrap_or(0.0);
     {
         let _s = progress.stage("removing degenerate and duplicate facets");
@@ -456,7 +456,7 @@ fn stitch(w: &mut Work, tol: f64) -> u64 {
     for e in 0..topo.edge_count() {
         let hs = topo.edge(e);
         if hs.len() == 1 {
-            let (a, b) = crate::mesh::topology::half_edge(mesh, hs[0]);
+            let (a, b) = crate::geom::topology::half_edge(mesh, hs[0]);
             bv.push(a);
             bv.push(b);
         }

@@ -14,8 +14,8 @@
 
 use crate::check::{check, CheckOptions};
 use crate::error::{Error, Result};
+use crate::geom::Mesh;
 use crate::grid::Grid;
-use crate::mesh::Mesh;
 
 /// Sub-voxel shifts of the grid, tried in turn (fractions of a voxel, far from simple ratios).
 const SHIFTS: [[f64; 3]; 3] = [
@@ -109,11 +109,11 @@ pub fn auto_voxel(mesh: &Mesh) -> f64 {
     auto_voxel_skipping(mesh, &[])
 }
 
-/// [`auto_voxel`], with the shells marked in `skip` (by [`crate::mesh::topology::Shells`] index)
+/// [`auto_voxel`], with the shells marked in `skip` (by [`crate::geom::topology::Shells`] index)
 /// left out of the smallest feature: a shell crossing itself has reaches down to nothing where
 /// it crosses, which say nothing of its features.
 pub fn auto_voxel_skipping(mesh: &Mesh, skip: &[bool]) -> f64 {
-    use crate::mesh::topology::{Shells, Topology};
+    use crate::geom::topology::{Shells, Topology};
     let Some(b) = mesh.bounds() else {
         return 1.0;
     };
@@ -125,9 +125,9 @@ pub fn auto_voxel_skipping(mesh: &Mesh, skip: &[bool]) -> f64 {
     let shells = Shells::new(mesh, &topo);
     let area = |f: u32| {
         let [a, b, c] = mesh.triangle(f as usize);
-        0.5 * crate::mesh::norm(crate::mesh::cross(
-            crate::mesh::sub(b, a),
-            crate::mesh::sub(c, a),
+        0.5 * crate::geom::norm(crate::geom::cross(
+            crate::geom::sub(b, a),
+            crate::geom::sub(c, a),
         ))
     };
     let area_total: f64 = shells.members.iter().flatten().map(|&f| area(f)).sum();

@@ -33,8 +33,8 @@ use crate::error::Error;
 use crate::error::Result;
 use crate::ffi::cgal::ffi;
 use crate::ffi::Backend;
-use crate::mesh::topology::{Shells, Topology, UnionFind};
-use crate::mesh::Mesh;
+use crate::geom::topology::{Shells, Topology, UnionFind};
+use crate::geom::Mesh;
 use std::time::{Duration, Instant};
 
 /// What making a solid did after the topological repair.

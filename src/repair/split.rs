@@ -4,8 +4,8 @@
 //! micrometres so the separation survives formats that weld by position.
 
 use crate::check::TJunction;
-use crate::mesh::topology::{corner_of, half_edge, Topology, UnionFind};
-use crate::mesh::{cross, dot, norm, sub, Mesh};
+use crate::geom::topology::{corner_of, half_edge, Topology, UnionFind};
+use crate::geom::{cross, dot, norm, sub, Mesh};
 
 /// Cuts every facet edge that has T-junction vertices inside it, re-triangulating the facet as a
 /// polygon with the extra vertices on its sides. Returns the number of vertices inserted.
@@ -49,7 +49,7 @@ pub fn split_t_junctions(mesh: &mut Mesh, tjs: &[TJunction]) -> u64 {
             }
         }
         let pts: Vec<[f64; 3]> = poly.iter().map(|&v| mesh.vertex(v)).collect();
-        match crate::mesh::triangulate::triangulate_polygon(&pts) {
+        match crate::geom::triangulate::triangulate_polygon(&pts) {
             Some(tris) => {
                 for tri in tris {
                     out.extend(tri.map(|k| poly[k]));

@@ -56,7 +56,7 @@ impl CliWriter {
 
 /// Loop direction code: 1 counter-clockwise, 0 clockwise, 2 open.
 fn direction(l: &[[f64; 2]]) -> i32 {
-    if super::contour::signed_area(l) > 0.0 {
+    if crate::geom::contour::signed_area(l) > 0.0 {
         1
     } else {
         0

@@ -1,5 +1,5 @@
 //! Sections of an implicit solid, without a mesh: the field sampled on the layer's plane and
-//! contoured by marching squares ([`super::contour::iso_loops`]). The plane is covered by blocks
+//! contoured by marching squares ([`crate::geom::contour::iso_loops`]). The plane is covered by blocks
 //! of 8 × 8 samples; a block whose centre's clearance (a distance within which the field keeps
 //! its sign) exceeds its half-diagonal lies wholly inside or outside and is not sampled further,
 //! so the work follows the length of the contours, not the area of the layer. Loops come out
@@ -9,9 +9,9 @@
 //! apart — and shrinks as h²: nothing is lost at a box's cut faces, where a mesh's sharp edges
 //! are rounded by its voxels.
 
-use super::contour::{iso_loops, Section};
 use super::Frame;
 use crate::field::{intersection_clearance, Aabb, Field, Vec3};
+use crate::geom::contour::{iso_loops, Section};
 
 /// Samples per block side.
 const BLOCK: usize = 8;
@@ -152,11 +152,11 @@ impl super::plan::Profile for ImplicitSlicer<'_> {
 
 /// In-layer bounds `[u_min, v_min, u_max, v_max]` and height range of a box along a frame.
 pub fn project(b: &Aabb, frame: &Frame) -> ([f64; 4], [f64; 2]) {
-    let mut out = super::contour::EMPTY_BOX;
+    let mut out = crate::geom::contour::EMPTY_BOX;
     let mut hs = [f64::INFINITY, f64::NEG_INFINITY];
     for k in 0..8 {
         let p = [0, 1, 2].map(|a| if k >> a & 1 == 1 { b.max[a] } else { b.min[a] });
-        out = super::contour::grow(out, frame.plane(p));
+        out = crate::geom::contour::grow(out, frame.plane(p));
         let h = frame.height(p);
         hs = [hs[0].min(h), hs[1].max(h)];
     }
@@ -166,7 +166,7 @@ pub fn project(b: &Aabb, frame: &Frame) -> ([f64; 4], [f64; 2]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::slice::contour::signed_area;
+    use crate::geom::contour::signed_area;
 
     /// A ball of radius 3 minus a ball of radius 1.5 (a hollow sphere), as a distance field.
     struct Shell;

@@ -3,7 +3,6 @@
 //! sections to the writers a chunk of layers at a time — memory holds one chunk of sections,
 //! never the whole stack.
 
-use super::contour::{grow, merge, EMPTY_BOX};
 use super::implicit::ImplicitSlicer;
 use super::mesh::{HeightIndex, MeshSlicer};
 use super::plan::{plan, Rule};
@@ -12,7 +11,8 @@ use crate::check::verify::{verify, Verify};
 use crate::check::{check, CheckOptions};
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Field, Vec3};
-use crate::mesh::Mesh;
+use crate::geom::contour::{grow, merge, EMPTY_BOX};
+use crate::geom::Mesh;
 use crate::progress::Progress;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};

@@ -14,9 +14,9 @@
 //! loops then run round the flat region, once. Chains that cannot close (a hole or a
 //! non-manifold edge crosses the plane) are kept as open chains and reported.
 
-use super::contour::{Loop, Section};
 use super::Frame;
-use crate::mesh::Mesh;
+use crate::geom::contour::{Loop, Section};
+use crate::geom::Mesh;
 use rayon::prelude::*;
 
 /// A mesh prepared for slicing along one build direction.
@@ -453,7 +453,7 @@ fn clean(pts: Vec<[f64; 2]>, closed: bool) -> Loop {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::slice::contour::signed_area;
+    use crate::geom::contour::signed_area;
 
     fn cube() -> Mesh {
         Mesh::cuboid([0.0; 3], [1.0; 3])

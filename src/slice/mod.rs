@@ -8,7 +8,6 @@
 //! `latvox slice` and batch jobs do.
 
 pub mod common_layer;
-pub mod contour;
 pub mod csv;
 pub mod implicit;
 pub mod job;
@@ -22,7 +21,7 @@ pub mod svg;
 use crate::error::{Error, Result};
 use crate::field::Vec3;
 
-pub use contour::{Loop, Section};
+pub use crate::geom::contour::{Loop, Section};
 pub use plan::Layer;
 
 /// The build frame: `d` the build direction (unit), `u` and `v` the in-layer axes, right-handed

@@ -4,7 +4,7 @@
 //! accumulation rasteriser of font-rs and stb_truetype). Outer loops counter-clockwise and holes
 //! clockwise cancel to exactly 0 inside a hole, so the mask's sum is the section's area in pixels.
 
-use super::contour::Loop;
+use crate::geom::contour::Loop;
 
 /// A `width × height` coverage mask, rows from the top; pixel `(i, j)` covers
 /// `[i, i + 1] × [j, j + 1]` in pixel units.
@@ -141,7 +141,7 @@ mod tests {
         m.add_loop(b.iter().copied());
         let cov = m.coverage();
         let sum: f64 = cov.iter().map(|&c| c as f64).sum();
-        let exact = crate::slice::contour::signed_area(&a) + crate::slice::contour::signed_area(&b);
+        let exact = crate::geom::contour::signed_area(&a) + crate::geom::contour::signed_area(&b);
         assert!((sum - exact).abs() < 1e-3 * exact, "{sum} vs {exact}");
         assert!(cov[50 * 101 + 50] < 1e-6);
         assert!(cov[50 * 101 + 20] > 1.0 - 1e-6);

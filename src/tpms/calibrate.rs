@@ -10,7 +10,7 @@
 //! 2. **Mesh level.** Meshing a surface on voxels changes its volume slightly (chords across
 //!    curved surfaces, sub-voxel features). The unit cell is meshed at the part's own voxel size
 //!    and phase twice, side by side: once with a margin of neighbouring cells, measuring the
-//!    volume inside the cell only ([`crate::mesh::Mesh::volume_in_box`]) — what every interior cell of the
+//!    volume inside the cell only ([`crate::geom::Mesh::volume_in_box`]) — what every interior cell of the
 //!    part contributes — and once clipped by its own box, whose difference from the first is the
 //!    effect of a cut face. A part of `nx × ny × nz` cells is predicted as
 //!    `interior + (1/nx + 1/ny + 1/nz)/3 · face`. The difference between that prediction and the

@@ -6,11 +6,11 @@ use super::calibrate::{self, Calibration, Connectivity, FeasibleRange};
 use super::{Domain, Lattice, LatticeFamily, Structure, Surface};
 use crate::check::Verdict;
 use crate::error::{Error, Result};
+use crate::geom::Mesh;
 use crate::io::sink::{MeshCollector, MeshSink};
 use crate::mesh::pipeline::{self, Options, Route, Solved};
 use crate::mesh::report::{LevelSearch, PartReport, Timings};
 use crate::mesh::resolution;
-use crate::mesh::Mesh;
 use crate::progress::Progress;
 use std::time::Instant;
 

@@ -21,9 +21,9 @@ pub use surface::{Structure, Surface, TpmsField};
 
 use crate::error::Result;
 use crate::field::{Aabb, Field, Vec3};
+use crate::geom::Mesh;
 use crate::grid::GridSpec;
 use crate::mesh::pipeline::{mesh_keyed, Family, Solid};
-use crate::mesh::Mesh;
 
 pub use crate::field::domain::Domain;
 pub use crate::mesh::pipeline::{MeshingStats, HALF_WIDTH};

@@ -1,12 +1,16 @@
 //! Fuzzing inside `cargo test`, each run bounded in time; new corpus entries go to a temporary
 //! folder, so the tree stays clean.
 //!
-//! - The mesh readers: each cargo-fuzz target (`fuzz/fuzz_targets`) runs from its committed seed
-//!   corpus (`fuzz/corpus/TARGET`) under AddressSanitizer, with a 2 GB memory limit. A crash, a
-//!   panic, an over-allocation or a broken mesh invariant fails the test. Needs a nightly
-//!   toolchain and cargo-fuzz (scripts/install-deps.sh installs them).
+//! - The mesh readers: in the main tier, each reader on its seed corpus (`fuzz/corpus/TARGET`)
+//!   and random mutations of it, in this process, with the invariants the fuzz targets assert.
+//!   In the long tier, each cargo-fuzz target (`fuzz/fuzz_targets`) runs coverage-guided from the
+//!   same seeds under AddressSanitizer, with a 2 GB memory limit: a crash, a panic, an
+//!   over-allocation or a broken mesh invariant fails the test. Needs a nightly toolchain and
+//!   cargo-fuzz (`scripts/install-deps.sh --tests` installs them).
 //! - `check` and `repair`, CGAL and OpenVDB behind them: the `check_repair` target
-//!   (`fuzz/cgal`) replayed on its corpus and random mutations of it, built with this crate.
+//!   (`fuzz/cgal`) replayed on its corpus and random mutations of it, built with this crate: a
+//!   sample of the corpus and a few seconds of mutations in the main tier, all of it and 20 s in
+//!   the long tier.
 
 use crate::common;
 
@@ -94,7 +98,84 @@ fn fuzz(dir: &Path, target: &str, seeds: &Path, seconds: u32) -> u64 {
         .unwrap_or_else(|| panic!("no run count from libFuzzer for {target}:\n{log}"))
 }
 
+/// What every reader's output must be, as the fuzz targets assert (`fuzz/src/lib.rs`): indices
+/// name vertices, coordinates are finite, a normal per facet, and welding keeps all of that.
+fn check_parsed(data: &[u8], format: latvox::io::Format) {
+    if let Ok(p) = latvox::io::parse(data, format) {
+        let m = p.mesh;
+        let nv = m.vertex_count();
+        assert!(m.indices.len() % 3 == 0 && m.positions.len() % 3 == 0);
+        assert!(m.indices.iter().all(|&i| (i as usize) < nv));
+        assert!(m.positions.iter().all(|x| x.is_finite()));
+        if let Some(n) = &p.normals {
+            assert_eq!(n.len(), m.triangle_count());
+        }
+        let mut welded = m.clone();
+        latvox::io::weld::weld_tolerance(&mut welded, 1e-3);
+        assert_eq!(welded.indices.len(), m.indices.len());
+        assert!(welded
+            .indices
+            .iter()
+            .all(|&i| (i as usize) < welded.vertex_count()));
+    }
+}
+
+/// `data` with one to four random changes: bytes set, flipped, inserted or dropped, or its
+/// tail replaced by another entry's.
+fn mutate(rng: &mut common::Rng, data: &mut Vec<u8>, corpus: &[Vec<u8>]) {
+    for _ in 0..1 + rng.below(4) {
+        let n = data.len().max(1) as u64;
+        let at = rng.below(n) as usize;
+        match rng.below(5) {
+            0 if !data.is_empty() => data[at] = rng.below(256) as u8,
+            1 if !data.is_empty() => data[at] ^= 1 << rng.below(8),
+            2 => data.insert(at.min(data.len()), rng.below(256) as u8),
+            3 if data.len() > 1 => {
+                data.remove(at);
+            }
+            _ => {
+                let other = &corpus[rng.below(corpus.len() as u64) as usize];
+                let from = rng.below(other.len().max(1) as u64) as usize;
+                data.truncate(at);
+                data.extend_from_slice(&other[from.min(other.len())..]);
+            }
+        }
+    }
+}
+
 #[test]
+fn every_reader_takes_its_seeds_and_their_mutations() {
+    use latvox::io::Format;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus");
+    let formats = [
+        ("stl", Format::Stl),
+        ("obj", Format::Obj),
+        ("off", Format::Off),
+        ("ply", Format::Ply),
+        ("threemf", Format::ThreeMf),
+    ];
+    let mut rng = common::Rng(0x5eed);
+    for (target, format) in formats {
+        let corpus: Vec<Vec<u8>> = std::fs::read_dir(root.join(target))
+            .unwrap()
+            .map(|e| std::fs::read(e.unwrap().path()).unwrap())
+            .collect();
+        assert!(!corpus.is_empty(), "no seed corpus for {target}");
+        for data in &corpus {
+            check_parsed(data, format);
+        }
+        let start = std::time::Instant::now();
+        while start.elapsed().as_secs_f64() < 1.0 {
+            let mut data = corpus[rng.below(corpus.len() as u64) as usize].clone();
+            mutate(&mut rng, &mut data, &corpus);
+            let r = std::panic::catch_unwind(|| check_parsed(&data, format));
+            assert!(r.is_ok(), "{target} reader fails on {data:?}");
+        }
+    }
+}
+
+#[test]
+#[ignore = "long: cargo fuzz builds a sanitized project and fuzzes each reader for 12 s"]
 fn every_reader_survives_fuzzing() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = root.join("fuzz");
@@ -114,17 +195,14 @@ fn every_reader_survives_fuzzing() {
 #[path = "../../fuzz/cgal/src/lib.rs"]
 mod check_repair;
 
-/// How long the replay of the check-and-repair corpus goes on mutating it, seconds.
-const MUTATION_SECONDS: u64 = 20;
-
 /// The `check_repair` fuzz target (`fuzz/cgal`: meshes with corners on a coarse grid through
-/// check, CGAL's checks, repair and `repair --solid`) on its committed corpus, then on random
-/// mutations of it (bytes changed, inserted, dropped, entries spliced) for a bounded time: never
-/// a panic, an abort or a backend error, every solid made valid by latvox's check and CGAL's.
-/// Coverage-guided runs of the same target: `cargo +nightly fuzz run --fuzz-dir fuzz/cgal -s none
-/// check_repair` (building the C++ bridges again takes ten minutes, so `cargo test` replays).
-#[test]
-fn check_and_repair_hold_on_the_fuzz_corpus_and_its_mutations() {
+/// check, CGAL's checks, repair and `repair --solid`) on its committed corpus (every `stride`-th
+/// entry), then on random mutations of it (bytes changed, inserted, dropped, entries spliced) for
+/// `seconds`: never a panic, an abort or a backend error, every solid made valid by latvox's check
+/// and CGAL's. Coverage-guided runs of the same target: `cargo +nightly fuzz run --fuzz-dir
+/// fuzz/cgal -s none check_repair` (building the C++ bridges again takes ten minutes, so `cargo
+/// test` replays).
+fn check_and_repair_replay(stride: usize, seconds: f64) {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/cgal/corpus/check_repair");
     let mut corpus: Vec<(String, Vec<u8>)> = std::fs::read_dir(&dir)
         .unwrap()
@@ -144,39 +222,35 @@ fn check_and_repair_hold_on_the_fuzz_corpus_and_its_mutations() {
         .filter(|(_, d)| check_repair::mesh(d).is_some())
         .count();
     assert!(solids >= 7, "only {solids} corpus entries make a mesh");
-    for (name, data) in &corpus {
+    for (name, data) in corpus.iter().step_by(stride) {
         let r = std::panic::catch_unwind(|| check_repair::check_repair(data));
         assert!(r.is_ok(), "corpus entry {name} fails");
     }
+    let entries: Vec<Vec<u8>> = corpus.iter().map(|(_, d)| d.clone()).collect();
     let mut rng = common::Rng(0xc6a1);
     let start = std::time::Instant::now();
     let mut runs = 0;
-    while start.elapsed().as_secs() < MUTATION_SECONDS {
-        let mut data = corpus[rng.below(corpus.len() as u64) as usize].1.clone();
-        for _ in 0..1 + rng.below(4) {
-            let n = data.len().max(1) as u64;
-            let at = rng.below(n) as usize;
-            match rng.below(5) {
-                0 if !data.is_empty() => data[at] = rng.below(256) as u8,
-                1 if !data.is_empty() => data[at] ^= 1 << rng.below(8),
-                2 => data.insert(at.min(data.len()), rng.below(256) as u8),
-                3 if data.len() > 1 => {
-                    data.remove(at);
-                }
-                _ => {
-                    let other = &corpus[rng.below(corpus.len() as u64) as usize].1;
-                    let from = rng.below(other.len() as u64) as usize;
-                    data.truncate(at);
-                    data.extend_from_slice(&other[from..]);
-                }
-            }
-        }
+    while start.elapsed().as_secs_f64() < seconds {
+        let mut data = entries[rng.below(entries.len() as u64) as usize].clone();
+        mutate(&mut rng, &mut data, &entries);
         let r = std::panic::catch_unwind(|| check_repair::check_repair(&data));
         assert!(r.is_ok(), "mutated input fails: {data:?}");
         runs += 1;
     }
     eprintln!(
-        "check and repair: {} corpus entries, {runs} mutations in {MUTATION_SECONDS} s",
+        "check and repair: {} of {} corpus entries, {runs} mutations in {seconds} s",
+        corpus.len().div_ceil(stride),
         corpus.len()
     );
+}
+
+#[test]
+fn check_and_repair_hold_on_a_sample_of_the_fuzz_corpus_and_its_mutations() {
+    check_and_repair_replay(16, 3.0);
+}
+
+#[test]
+#[ignore = "long: the whole check-and-repair corpus and 20 s of its mutations"]
+fn check_and_repair_hold_on_the_fuzz_corpus_and_its_mutations() {
+    check_and_repair_replay(1, 20.0);
 }

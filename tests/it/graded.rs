@@ -150,9 +150,10 @@ fn check_cells(
     worst
 }
 
-/// The must-show part: a 6×6×6-cell gyroid net graded 0.1 → 0.4 along z.
-#[test]
-fn a_gyroid_graded_along_z_meets_the_grade_in_every_cell() {
+/// A gyroid net graded 0.1 → 0.4 along z over six cells, `across` cells wide.
+fn gyroid_graded_along_z(across: u32) {
+    let cells = format!("{across},{across},6");
+    let across = 5.0 * across as f64;
     let worst = check_graded(
         &[
             "tpms",
@@ -161,7 +162,7 @@ fn a_gyroid_graded_along_z_meets_the_grade_in_every_cell() {
             "--density-grade",
             "z:0.1:0.4",
             "--cells",
-            "6",
+            &cells,
             "--cell-size",
             "5",
             "-r",
@@ -169,11 +170,24 @@ fn a_gyroid_graded_along_z_meets_the_grade_in_every_cell() {
         ],
         [0.0; 3],
         [5.0; 3],
-        [30.0; 3],
+        [across, across, 30.0],
         &|p| 0.1 + 0.3 * p[2] / 30.0,
     );
     // The grade is met far inside the promise.
     assert!(worst < 0.005, "{worst}");
+}
+
+/// A column of the must-show part: 2×2×6 cells.
+#[test]
+fn a_gyroid_column_graded_along_z_meets_the_grade_in_every_cell() {
+    gyroid_graded_along_z(2);
+}
+
+/// The must-show part: a 6×6×6-cell gyroid net graded 0.1 → 0.4 along z.
+#[test]
+#[ignore = "long: 216 graded cells, each measured by manifold3d"]
+fn a_gyroid_graded_along_z_meets_the_grade_in_every_cell() {
+    gyroid_graded_along_z(6);
 }
 
 /// The must-show blend: a gyroid net turning into a diamond net along x at 30 %, the weight
@@ -257,10 +271,11 @@ fn a_gyroid_blended_into_a_diamond_holds_the_density_in_every_cell() {
     );
 }
 
-/// The must-show strut part: a 6×6×6-cell BCC block graded 0.1 → 0.4 along z (the strut
-/// radius varies with the height).
-#[test]
-fn a_bcc_block_graded_along_z_meets_the_grade_in_every_cell() {
+/// A BCC block graded 0.1 → 0.4 along z over six cells, `across` cells wide (the strut radius
+/// varies with the height).
+fn bcc_graded_along_z(across: u32) {
+    let cells = format!("{across},{across},6");
+    let across = 5.0 * across as f64;
     let worst = check_graded(
         &[
             "strut",
@@ -269,7 +284,7 @@ fn a_bcc_block_graded_along_z_meets_the_grade_in_every_cell() {
             "--density-grade",
             "z:0.1:0.4",
             "--cells",
-            "6",
+            &cells,
             "--cell-size",
             "5",
             "-r",
@@ -277,24 +292,36 @@ fn a_bcc_block_graded_along_z_meets_the_grade_in_every_cell() {
         ],
         [0.0; 3],
         [5.0; 3],
-        [30.0; 3],
+        [across, across, 30.0],
         &|p| 0.1 + 0.3 * p[2] / 30.0,
     );
     assert!(worst < 0.005, "{worst}");
 }
 
-/// The must-show fill: a 30 mm cube with a 1 mm skin, its gyroid core dense near the skin and
-/// open inside (`d`, the depth below the skin); every cell wholly inside the core (here, away
-/// from the cube's faces by more than the skin) meets the field at its centre, the depth there
-/// computed by this test from the cube's faces.
+/// A column of the must-show strut part: 2×2×6 cells.
 #[test]
-fn a_fill_graded_by_depth_below_the_skin_meets_it_in_every_core_cell() {
+fn a_bcc_column_graded_along_z_meets_the_grade_in_every_cell() {
+    bcc_graded_along_z(2);
+}
+
+/// The must-show strut part: a 6×6×6-cell BCC block.
+#[test]
+#[ignore = "long: 216 graded strut cells, each measured by manifold3d"]
+fn a_bcc_block_graded_along_z_meets_the_grade_in_every_cell() {
+    bcc_graded_along_z(6);
+}
+
+/// A cube of `edge` mm with a 1 mm skin, its gyroid core dense near the skin and open inside
+/// (`d`, the depth below the skin); every cell wholly inside the core (here, away from the
+/// cube's faces by more than the skin) meets the field at its centre, the depth there computed
+/// by this test from the cube's faces.
+fn fill_graded_by_depth(edge: f64) {
     let dir = tempdir();
     let cube = dir.path().join("cube.stl");
-    meshkit::write_stl(&cube, &meshkit::cuboid([0.0; 3], [30.0; 3]));
+    meshkit::write_stl(&cube, &meshkit::cuboid([0.0; 3], [edge; 3]));
     let depth = |p: [f64; 3]| {
         (0..3)
-            .map(|a| p[a].min(30.0 - p[a]))
+            .map(|a| p[a].min(edge - p[a]))
             .fold(f64::INFINITY, f64::min)
             - 1.0
     };
@@ -315,11 +342,24 @@ fn a_fill_graded_by_depth_below_the_skin_meets_it_in_every_core_cell() {
         ],
         [0.0; 3],
         [5.0; 3],
-        [30.0; 3],
+        [edge; 3],
         &|p| (0.35 - 0.03 * depth(p).max(0.0)).max(0.12),
-        &|lo| (0..3).all(|a| lo[a] >= 1.0 && lo[a] + 5.0 <= 29.0),
+        &|lo| (0..3).all(|a| lo[a] >= 1.0 && lo[a] + 5.0 <= edge - 1.0),
     );
     assert!(worst < 0.005, "{worst}");
+}
+
+/// A 20 mm cube filled, graded by depth: eight core cells.
+#[test]
+fn a_small_fill_graded_by_depth_below_the_skin_meets_it_in_every_core_cell() {
+    fill_graded_by_depth(20.0);
+}
+
+/// The must-show fill: a 30 mm cube.
+#[test]
+#[ignore = "long: the must-show filled cube, 64 core cells measured by manifold3d"]
+fn a_fill_graded_by_depth_below_the_skin_meets_it_in_every_core_cell() {
+    fill_graded_by_depth(30.0);
 }
 
 /// Struts filling a ball, graded along z across its box (no skin: the lattice cut by the
@@ -364,10 +404,21 @@ fn a_strut_fill_graded_along_z_meets_it_in_every_inner_cell() {
 /// Strut cells graded at random (seeded): cell, axis, the grade's ends, a box that may end
 /// inside a cell, an origin, a resolution; and an octet truss graded by an expression, its
 /// joints blended.
+/// The main tier grades one random strut part and the octet; the long tier, two and the octet.
 #[test]
+fn strut_lattices_are_graded_for_a_random_setting() {
+    strut_gradings(1);
+}
+
+#[test]
+#[ignore = "long: two random strut gradings and the octet"]
 fn strut_lattices_are_graded_for_every_setting() {
+    strut_gradings(2);
+}
+
+fn strut_gradings(random: usize) {
     let mut rng = Rng(0x57_2a7);
-    for _ in 0..2 {
+    for _ in 0..random {
         let name = ["bcc", "octet", "kelvin", "fccz"][rng.below(4) as usize];
         let axis = rng.below(3) as usize;
         let a = rng.uniform(0.08, 0.3);
@@ -458,9 +509,20 @@ fn an_expression_field_is_met_cell_by_cell() {
 }
 
 /// A sheet graded along x in a box that is not a whole number of cells, at an odd origin, on
-/// coarse voxels (raised for the thinnest walls); and a field sampled in a .npy file.
+/// coarse voxels (raised for the thinnest walls); and fields sampled in a .vdb file and (in the
+/// long tier) a .npy file.
 #[test]
+fn partial_cells_odd_origins_and_a_sampled_field() {
+    partial_cells_and_sampled_fields(false);
+}
+
+#[test]
+#[ignore = "long: the partial cells and both sampled fields"]
 fn partial_cells_odd_origins_and_sampled_fields() {
+    partial_cells_and_sampled_fields(true);
+}
+
+fn partial_cells_and_sampled_fields(npy_too: bool) {
     check_graded(
         &[
             "tpms",
@@ -493,26 +555,28 @@ fn partial_cells_odd_origins_and_sampled_fields() {
     let mut bytes = Vec::new();
     latvox::io::npy::write(&mut bytes, &[3, 4, 5], &data).unwrap();
     std::fs::write(&npy, bytes).unwrap();
-    check_graded(
-        &[
-            "tpms",
-            "--type",
-            "p",
-            "--density-field",
-            npy.to_str().unwrap(),
-            "--cells",
-            "3,4,4",
-            "--cell-size",
-            "5",
-            "-r",
-            "24",
-        ],
-        [0.0; 3],
-        [5.0; 3],
-        [15.0, 20.0, 20.0],
-        // Trilinear between samples 20/3 mm apart along y.
-        &|p| 0.25 + 0.05 * (p[1] / (20.0 / 3.0)).clamp(0.0, 3.0),
-    );
+    if npy_too {
+        check_graded(
+            &[
+                "tpms",
+                "--type",
+                "p",
+                "--density-field",
+                npy.to_str().unwrap(),
+                "--cells",
+                "3,4,4",
+                "--cell-size",
+                "5",
+                "-r",
+                "24",
+            ],
+            [0.0; 3],
+            [5.0; 3],
+            [15.0, 20.0, 20.0],
+            // Trilinear between samples 20/3 mm apart along y.
+            &|p| 0.25 + 0.05 * (p[1] / (20.0 / 3.0)).clamp(0.0, 3.0),
+        );
+    }
     // A .vdb made by OpenVDB's Python module: a grid of 0.8 mm voxels whose index (0, 0, 0) sits
     // at -1.2 mm, holding 0.15 + 0.01·z at each voxel's centre.
     let vdb = dir.path().join("field.vdb");
@@ -565,8 +629,19 @@ vdb.write(sys.argv[1], grids=[g])
 
 /// Settings drawn at random (seeded): type, structure, axis, the grade's ends within the type's
 /// feasible range, cell counts, a box that may end inside a cell, an origin, a resolution.
+/// The main tier meets one random grade; the long tier, three.
 #[test]
+fn a_random_grade_is_met_in_every_whole_cell() {
+    random_grades(1);
+}
+
+#[test]
+#[ignore = "long: three random grades"]
 fn random_grades_are_met_in_every_whole_cell() {
+    random_grades(3);
+}
+
+fn random_grades(count: usize) {
     let mut rng = Rng(0x5eed_9ade);
     // (type, structure, lowest density that stays clear of the feasible range's end)
     let types = [
@@ -576,7 +651,7 @@ fn random_grades_are_met_in_every_whole_cell() {
         ("gyroid", "sheet", 0.1),
         ("iwp", "sheet", 0.1),
     ];
-    for _ in 0..3 {
+    for _ in 0..count {
         let (ty, st, lo) = types[rng.below(types.len() as u64) as usize];
         let axis = rng.below(3) as usize;
         let a = rng.uniform(lo, 0.3);
@@ -1002,6 +1077,7 @@ fn a_tube_of_gyroid_cells_wrapped_around_its_axis_holds_the_density_in_every_cel
 /// A diamond sheet tube two cells through the wall (each layer weighed by its radius), on a
 /// small bore: every cell and layer at the density.
 #[test]
+#[ignore = "long: a sheet tube two cells through the wall, every cell and layer measured"]
 fn a_sheet_tube_of_several_layers_holds_the_density_in_every_cell() {
     let worst = check_tube(
         &["--structure", "sheet", "-r", "20"],
@@ -1162,6 +1238,7 @@ fn check_shell(
 /// and corners too) at the density, closed and clean. (Layers through the wall are measured
 /// as a tube's are: `a_sheet_tube_of_several_layers_holds_the_density_in_every_cell`.)
 #[test]
+#[ignore = "long: a spherical shell, every cell warped and measured by manifold3d"]
 fn a_spherical_shell_of_gyroid_cells_holds_the_density_in_every_cell() {
     let worst = check_shell(
         &["-r", "12"],
@@ -1652,9 +1729,20 @@ fn cells_whose_members_break_loose_are_met_on_finer_voxels() {
 /// Spherical shells of the types whose members pinch where the cubed sphere narrows its cells
 /// (two sheets of the surface through one voxel, snapped onto the exact surface, used to cross):
 /// CGAL finds each closed and free of self-intersections at coarse voxels.
+/// The main tier makes the Lidinoid's shell; the long tier, all three.
 #[test]
+fn a_shell_of_a_pinching_type_is_free_of_self_intersections() {
+    pinching_shells(&["lidinoid"]);
+}
+
+#[test]
+#[ignore = "long: three pinching types' shells checked by CGAL"]
 fn shells_of_pinching_types_are_free_of_self_intersections() {
-    for t in ["lidinoid", "split-p", "s"] {
+    pinching_shells(&["lidinoid", "split-p", "s"]);
+}
+
+fn pinching_shells(types: &[&str]) {
+    for &t in types {
         let dir = tempdir();
         ok(
             &[

@@ -6,7 +6,7 @@
 //! 0.5 mm steps, 0 to 4 mm, where coincident, collinear and coplanar corners are common — then
 //! three bytes per facet, each a vertex index modulo the count (up to 64 facets).
 
-use latvox::mesh::Mesh;
+use latvox::geom::Mesh;
 use latvox::progress::Progress;
 use latvox::repair::{repair, Remesh, RepairOptions};
 

@@ -14,7 +14,7 @@ pub use grid::Stars;
 use crate::error::Result;
 use crate::ffi::cgal::ffi;
 use crate::ffi::Backend;
-use crate::mesh::Mesh;
+use crate::geom::Mesh;
 use crate::progress::Progress;
 use rayon::prelude::*;
 

@@ -2,7 +2,7 @@
 
 use crate::field::{Aabb, Vec3};
 use crate::fill::traced::Traced;
-use crate::render::bvh::Bvh;
+use crate::geom::bvh::Bvh;
 use crate::render::{Model, Periodic};
 use crate::tpms::Structure;
 use serde::Serialize;

@@ -7,7 +7,7 @@
 //! hashing at a million facets, and in a deterministic order (by vertex pair). Facets with a repeated vertex index take no part (they have no proper
 //! edges); `check` counts them separately.
 
-use crate::mesh::Mesh;
+use super::Mesh;
 use rayon::prelude::*;
 
 /// Edges and incidences of a mesh.

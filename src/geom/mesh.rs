@@ -3,7 +3,7 @@
 //! Measures here (volume by the divergence theorem, area, bounds, edge incidence) are latvox's
 //! own; [`crate::check::cgal`] re-measures with CGAL, independently.
 
-use crate::field::{Aabb, Vec3};
+use super::{Aabb, Vec3};
 
 /// An indexed triangle mesh with flat storage (`positions` in xyz triples, `indices` in triples).
 #[derive(Debug, Clone, Default, PartialEq)]

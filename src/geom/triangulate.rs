@@ -6,7 +6,7 @@
 //! triangles keep the polygon's winding. `None` when the outline is not a simple polygon in its
 //! projection (self-crossing, or folded), so the caller can fall back to something else.
 
-use crate::field::Vec3;
+use super::Vec3;
 
 /// Newell's normal of a closed polygon (length = twice its vector area).
 pub fn newell_normal(pts: &[Vec3]) -> Vec3 {

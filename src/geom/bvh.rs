@@ -6,9 +6,7 @@
 //! triangle count; a ray that starts inside a box (the camera inside the part) enters it at 0.
 //! Triangles are hit from both sides (Möller–Trumbore), so open shells render too.
 
-use super::camera::{cross, dot, Ray};
-use crate::field::{Aabb, Vec3};
-use crate::mesh::Mesh;
+use super::{cross, dot, Aabb, Mesh, Ray, Vec3};
 
 const LEAF: usize = 4;
 const BINS: usize = 16;
