@@ -200,16 +200,16 @@ fn main() {
     let mesh = &loaded.mesh;
     let all: Vec<u32> = (0..mesh.triangle_count() as u32).collect();
     let (t_ours, ours) = time(runs, || {
-        latvox::check::self_intersect::soup_self_intersections(mesh, &all, 16)
+        latvox::verify::self_intersect::soup_self_intersections(mesh, &all, 16)
     });
     let c_ours = cpu();
     let (t_whole, whole) = time(runs, || {
-        latvox::check::self_intersect::soup_self_intersections_in_tiles(mesh, &all, None, 16, 0)
+        latvox::verify::self_intersect::soup_self_intersections_in_tiles(mesh, &all, None, 16, 0)
             .unwrap()
     });
     let c_whole = cpu();
     let (t_tiled, tiled) = time(runs, || {
-        latvox::check::self_intersect::cgal_soup_self_intersections(mesh, &all, None, 16).unwrap()
+        latvox::verify::self_intersect::cgal_soup_self_intersections(mesh, &all, None, 16).unwrap()
     });
     let c_tiled = cpu();
     assert_eq!(whole, tiled);

@@ -47,7 +47,7 @@ fn main() {
         resolution,
         auto_resolution: false,
         options: Options {
-            verify: latvox::check::verify::Verify::Full,
+            verify: latvox::verify::Verify::Full,
             instancing: false,
             memory: Some(memory),
             ..Default::default()

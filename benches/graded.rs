@@ -43,7 +43,7 @@ fn one(config: &str) {
         adaptivity: 0.0,
         allow_islands: false,
         auto_resolution: true,
-        verify: latvox::check::verify::Verify::Full,
+        verify: latvox::verify::Verify::Full,
         instancing: config == "uniform-instanced",
         tile: None,
         memory: (config == "graded-tiled").then_some(500 << 20),

@@ -27,7 +27,7 @@
 //! coordinates), then every edge counted here — boundary edges (one triangle), non-manifold
 //! edges (three or more), edges whose two triangles run the same way — degenerate triangles
 //! (a repeated welded vertex), the enclosed volume, each vertex's distance to the exact surface;
-//! the edges again after welding within [`NEAR_WELD`]; and CGAL's checks (`latvox::check::cgal`, with
+//! the edges again after welding within [`NEAR_WELD`]; and CGAL's checks (`latvox::verify::cgal`, with
 //! the self-intersection test) on the welded mesh (not on the larger part's meshes). The job's
 //! mesh is checked as written: its STL file is read back here; its CGAL checks are its own.
 //!
@@ -210,7 +210,7 @@ fn child(a: &[String]) {
                 adaptivity: 0.0,
                 allow_islands: false,
                 auto_resolution: true,
-                verify: latvox::check::verify::Verify::Full,
+                verify: latvox::verify::Verify::Full,
                 instancing: true,
                 tile: None,
                 memory: None,
@@ -494,13 +494,13 @@ fn check_mesh(m: &Mesh, exact: &dyn Field, voxel: f64, box_volume: f64, cgal: bo
         })
         .sum();
     let t = Instant::now();
-    let cgal = cgal.then(|| latvox::check::cgal::verify(&welded, true).expect("CGAL check"));
+    let cgal = cgal.then(|| latvox::verify::cgal::verify(&welded, true).expect("CGAL check"));
     let cgal_seconds = t.elapsed().as_secs_f64();
     let (near, near_degenerate) = weld(m, Some(NEAR_WELD));
     let [_, near_boundary, near_non_manifold, near_same_way] = edge_counts(&near);
     // CGAL again on the nearly welded mesh when that one closes and the exact one did not.
     let near_cgal = (cgal.is_some() && boundary > 0 && near_boundary == 0)
-        .then(|| latvox::check::cgal::verify(&near, true).expect("CGAL check"));
+        .then(|| latvox::verify::cgal::verify(&near, true).expect("CGAL check"));
     json!({
         "vertices": welded.vertex_count(),
         "degenerate": degenerate,

@@ -32,7 +32,7 @@ fn scale(n: u32) {
         resolution: 16,
         auto_resolution: false,
         options: Options {
-            verify: latvox::check::verify::Verify::Full,
+            verify: latvox::verify::Verify::Full,
             instancing: true,
             ..Default::default()
         },
@@ -75,7 +75,7 @@ fn main() {
             resolution: 32,
             auto_resolution: true,
             options: Options {
-                verify: latvox::check::verify::Verify::Full,
+                verify: latvox::verify::Verify::Full,
                 instancing: true,
                 ..Default::default()
             },

@@ -15,9 +15,9 @@
 //!
 //! Run: `cargo bench --bench verify` (`-- --runs N`, `-- --parts 1,3`).
 
-use latvox::check::verify::{verify, Verify};
 use latvox::io::ReadOptions;
 use latvox::progress::Progress;
+use latvox::verify::{verify, Verify};
 use std::path::Path;
 use std::process::Command;
 use std::time::Instant;

@@ -46,7 +46,7 @@
 //! let exact = 4.0 / 3.0 * std::f64::consts::PI * 5.0f64.powi(3);
 //! assert!((mesh.volume() / exact - 1.0).abs() < 0.01);
 //! // CGAL agrees: closed, wound outward, free of self-intersections.
-//! let checks = latvox::check::cgal::verify(&mesh, true)?;
+//! let checks = latvox::verify::cgal::verify(&mesh, true)?;
 //! assert!(checks.closed && checks.outward && !checks.self_intersecting);
 //! # Ok::<(), latvox::Error>(())
 //! ```
@@ -73,5 +73,6 @@ pub mod slice;
 pub mod strut;
 pub mod topopt;
 pub mod tpms;
+pub mod verify;
 
 pub use error::{Error, Result};

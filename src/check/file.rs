@@ -2,11 +2,11 @@
 //! by side, and join their findings into one [`Verdict`] and one report.
 
 use super::{check, CheckOptions, CheckReport, Verdict};
-use crate::check::cgal::Verification;
 use crate::error::Result;
 use crate::geom::EdgeStats;
 use crate::io::{Format, Loaded, ReadOptions, Reading};
 use crate::progress::Progress;
+use crate::verify::cgal::Verification;
 use std::path::Path;
 
 /// The defect classes found, with their counts, in the order [`CheckReport::defects`] gives
@@ -34,7 +34,10 @@ pub struct FileCheckReport {
     /// The file's format, as read.
     pub format: Format,
     /// latvox's and CGAL's findings together (in JSON, the one flag `valid_solid`).
-    #[serde(rename = "valid_solid", serialize_with = "super::verdict::valid_solid")]
+    #[serde(
+        rename = "valid_solid",
+        serialize_with = "crate::verify::verdict::valid_solid"
+    )]
     pub verdict: Verdict,
     /// Triangles after reading (polygons split).
     pub triangles: u64,
@@ -78,7 +81,7 @@ pub fn check_file(
         let _s = progress.stage("checking");
         rayon::join(
             || check(mesh, loaded.normals.as_deref(), opts),
-            || crate::check::cgal::verify(mesh, false),
+            || crate::verify::cgal::verify(mesh, false),
         )
     };
     let (report, mut cgal) = (report?, cgal?);

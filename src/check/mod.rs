@@ -11,21 +11,17 @@
 //! edge counted in one class. Self-intersections are counted by CGAL among the facets that are
 //! neither degenerate nor duplicates (those are counted on their own).
 
-pub mod cgal;
 pub mod deviation;
 mod file;
 pub mod reach;
-pub mod self_intersect;
-pub(crate) mod verdict;
-pub mod verify;
 
 pub use file::{check_file, read_file, Defects, FileCheckReport};
-pub use verdict::Verdict;
 
 use crate::error::Result;
 use crate::field::Vec3;
 use crate::geom::topology::{half_edge, Shells, Topology};
 use crate::geom::{cross, dot, norm, signed_volume, sub, Mesh};
+use crate::verify::Verdict;
 use rayon::prelude::*;
 
 /// A facet whose area is below this fraction of its longest edge squared is degenerate
@@ -827,7 +823,7 @@ fn self_intersections(mesh: &Mesh, topo: &Topology, bad: &FacetDefects) -> (u64,
     let keep: Vec<u32> = (0..nf as u32)
         .filter(|&f| topo.active[f as usize] && !zero[f as usize] && !is_dup[f as usize])
         .collect();
-    crate::check::self_intersect::soup_self_intersections(mesh, &keep, 16)
+    crate::verify::self_intersect::soup_self_intersections(mesh, &keep, 16)
 }
 
 /// The shell of the facet that owns boundary half-edge a→b.
@@ -849,4 +845,30 @@ fn boundary_shell(mesh: &Mesh, topo: &Topology, shell_of: &[u32], a: u32, b: u32
     }
     (lo < topo.edge_count() && key(topo.edge(lo)[0]) == want)
         .then(|| shell_of[(topo.edge(lo)[0] / 3) as usize] as usize)
+}
+
+impl From<&CheckReport> for Verdict {
+    /// latvox's own findings: valid exactly when [`CheckReport::defects`] is empty.
+    fn from(r: &CheckReport) -> Verdict {
+        let normals = r.normals.unwrap_or_default();
+        Verdict {
+            closed: r.boundary_edges == 0 && r.hole_loops == 0,
+            manifold: r.non_manifold_edges == 0 && r.non_manifold_vertices == 0,
+            outward: r.inconsistent_edges == 0
+                && r.inward_shells == 0
+                && r.non_orientable_shells == 0,
+            self_intersection_checked: r.self_intersections.is_some(),
+            self_intersecting: r.self_intersections.unwrap_or(0) > 0,
+            sound_facets: r.facets > 0
+                && r.repeated_vertex_facets == 0
+                && r.zero_area_facets == 0
+                && r.duplicate_facets == 0
+                && r.t_junctions == 0
+                && normals.reversed == 0
+                && normals.inaccurate == 0,
+            one_piece: None,
+            density_met: None,
+            features_printable: None,
+        }
+    }
 }

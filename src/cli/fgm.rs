@@ -6,12 +6,12 @@ use super::command::{job, parsed, Command, PartKeys};
 use super::out::outln;
 use super::{cgal_findings, parse_positive, write_json};
 use clap::Args;
-use latvox::check::verify::Verify;
 use latvox::fgm::material::{Composition, Feature, Features, Law};
 use latvox::fgm::stack::{StackReport, StackSpec};
 use latvox::fgm::{FgmJob, Geometry, Sign};
 use latvox::io::ReadOptions;
 use latvox::progress::Progress;
+use latvox::verify::Verify;
 use latvox::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -221,7 +221,7 @@ pub struct FgmReport {
     vertices: usize,
     volume: Option<f64>,
     /// The part mesh's verification (the job's verdict).
-    pub checks: latvox::check::cgal::Verification,
+    pub checks: latvox::verify::cgal::Verification,
     stack: Option<StackReport>,
     outputs: Vec<String>,
     timings: serde_json::Map<String, serde_json::Value>,

@@ -5,11 +5,11 @@ use super::command::{self, parsed, Command};
 use super::out::outln;
 use super::{cgal_findings, write_json};
 use clap::Args;
-use latvox::check::verify::Verify;
 use latvox::grid::Smoothing;
 use latvox::interpret::job;
 use latvox::interpret::{interpret_file, InterpretFiles, InterpretOptions, InterpretPart};
 use latvox::progress::Progress;
+use latvox::verify::Verify;
 use latvox::Result;
 use std::path::PathBuf;
 

@@ -7,7 +7,6 @@ use super::{
     parse_unit, write_json,
 };
 use clap::Args;
-use latvox::check::verify::Verify;
 use latvox::field::density::DensityField;
 use latvox::field::Domain;
 use latvox::io::sink::MeshSink;
@@ -15,6 +14,7 @@ use latvox::mesh::graded::{Grading, GradingReport};
 use latvox::mesh::output::MeshFile;
 use latvox::mesh::pipeline::Options;
 use latvox::mesh::report::PartReport;
+use latvox::verify::Verify;
 use latvox::{Error, Result};
 use std::path::PathBuf;
 

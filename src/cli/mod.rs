@@ -183,8 +183,8 @@ pub(crate) fn emit_json(
 }
 
 /// The findings of a verification (latvox's or CGAL's), as the summaries print them.
-pub(crate) fn cgal_findings(c: &latvox::check::cgal::Verification) -> String {
-    if c.checked_by == latvox::check::verify::Verify::None.by() {
+pub(crate) fn cgal_findings(c: &latvox::verify::cgal::Verification) -> String {
+    if c.checked_by == latvox::verify::Verify::None.by() {
         return "not checked (--verify none)".into();
     }
     let refused = c

@@ -1,5 +1,5 @@
 //! The CGAL bridge (`cpp/cgal.h`, implemented by `cpp/cgal_*.cc`). Raw declarations only;
-//! `crate::check::cgal` and `crate::repair::cgal` wrap them safely.
+//! `crate::verify::cgal` and `crate::repair::cgal` wrap them safely.
 
 #[cxx::bridge(namespace = "latvox")]
 pub(crate) mod ffi {

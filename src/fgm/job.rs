@@ -6,8 +6,6 @@
 use super::cloud::Cloud;
 use super::geometry::{ScanSdf, Sign};
 use super::material::{Composition, Features};
-use crate::check::cgal::Verification;
-use crate::check::verify::{verify, Verify};
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Vec3};
 use crate::geom::Mesh;
@@ -16,6 +14,8 @@ use crate::io::points::PointCloud;
 use crate::mesh::extract::KeyedMesh;
 use crate::mesh::pipeline::HALF_WIDTH;
 use crate::progress::Progress;
+use crate::verify::cgal::Verification;
+use crate::verify::{verify, Verify};
 use rayon::prelude::*;
 use std::time::Instant;
 

@@ -7,7 +7,6 @@
 //! [`crate::mesh::resolution`]'s.
 
 use super::shape::{Drain, FillFamily, FillSolid, Infill, Shape};
-use crate::check::Verdict;
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Vec3};
 use crate::geom::Mesh;
@@ -22,6 +21,7 @@ use crate::strut::job::MIN_STRUT_VOXELS;
 use crate::strut::{RadiusModel, StrutFamily, StrutLattice, UnitCell};
 use crate::tpms::job::MIN_WALL_VOXELS;
 use crate::tpms::{calibrate, Lattice, LatticeFamily, Structure, Surface};
+use crate::verify::Verdict;
 use std::sync::Arc;
 use std::time::Instant;
 

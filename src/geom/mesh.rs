@@ -1,7 +1,7 @@
 //! The mesh type: indexed triangles, wound counter-clockwise seen from outside, in millimetres.
 //!
 //! Measures here (volume by the divergence theorem, area, bounds, edge incidence) are latvox's
-//! own; [`crate::check::cgal`] re-measures with CGAL, independently.
+//! own; [`crate::verify::cgal`] re-measures with CGAL, independently.
 
 use super::{Aabb, Vec3};
 

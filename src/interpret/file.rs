@@ -36,7 +36,7 @@ pub struct InterpretOptions {
     /// 3D: the smoothing flow.
     pub smoothing: Smoothing,
     /// How the 3D part is verified.
-    pub verify: crate::check::verify::Verify,
+    pub verify: crate::verify::Verify,
 }
 
 /// A 2D field refined by the default 8 pixels per element may have at most this many pixels.

@@ -7,12 +7,12 @@ use super::contour::{self, Loop};
 use super::{extrude, volume, Density};
 use crate::cad::bspline::Periodic;
 use crate::cad::fit;
-use crate::check::cgal::Verification;
-use crate::check::Verdict;
 use crate::error::Result;
 use crate::geom::Mesh;
 use crate::grid::Smoothing;
 use crate::progress::Progress;
+use crate::verify::cgal::Verification;
+use crate::verify::Verdict;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -28,7 +28,7 @@ pub struct InterpretJob {
     /// Fit the CAD curves (2D only).
     pub fit_curves: bool,
     /// How the 3D part is verified.
-    pub verify: crate::check::verify::Verify,
+    pub verify: crate::verify::Verify,
     /// 3D: OpenVDB level-set smoothing passes (0: none) and the flow.
     pub smooth_iterations: u32,
     /// The level-set flow used for smoothing.
@@ -204,7 +204,7 @@ pub fn run(d: &Density, job: &InterpretJob, progress: &Progress) -> Result<Inter
     let t = Instant::now();
     let checks = {
         let _s = progress.stage("verifying");
-        crate::check::verify::verify(&mesh, job.verify, progress)?
+        crate::verify::verify(&mesh, job.verify, progress)?
     };
     timings.verify = t.elapsed().as_secs_f64();
 

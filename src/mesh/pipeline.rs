@@ -21,8 +21,6 @@
 //! [`solve`] says so with the closest fraction it found, and the caller raises the resolution
 //! or refuses.
 
-use crate::check::cgal::Verification;
-use crate::check::verify::{verify, Verify};
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Field, Intersection, Vec3};
 use crate::geom::Mesh;
@@ -34,6 +32,8 @@ use crate::mesh::pieces::{self, Fragments};
 use crate::mesh::snap::SnapStats;
 use crate::mesh::tile;
 use crate::progress::Progress;
+use crate::verify::cgal::Verification;
+use crate::verify::{verify, Verify};
 use std::time::Instant;
 
 /// Default narrow-band half width, voxels.
@@ -686,7 +686,7 @@ fn write_instanced(
                 let t = Instant::now();
                 let r = match o.verify {
                     // CGAL's parallel search would take the writer's core.
-                    Verify::Cgal => crate::check::cgal::verify_on(&template_mesh, true, false),
+                    Verify::Cgal => crate::verify::cgal::verify_on(&template_mesh, true, false),
                     v => verify(&template_mesh, v, &Progress::hidden()),
                 };
                 (r, t.elapsed().as_secs_f64())

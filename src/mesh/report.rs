@@ -7,9 +7,9 @@
 use super::pieces::Fragments;
 use super::pipeline::{Instancing, Made, Measured, MeshingStats, Route, Tiling, Written, PROMISE};
 use super::resolution::ResolutionMiss;
-use crate::check::cgal::Verification;
-use crate::check::Verdict;
 use crate::field::Aabb;
+use crate::verify::cgal::Verification;
+use crate::verify::Verdict;
 
 /// Timings per stage, seconds.
 #[derive(Debug, Clone, Copy, Default, serde::Serialize)]

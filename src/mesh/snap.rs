@@ -156,8 +156,8 @@ pub fn unfold(mesh: &mut KeyedMesh, spec: &GridSpec) -> u64 {
 /// such triangle is tested exactly against the others within a voxel of it; repeats for at
 /// most [`UNFOLD_PASSES`] passes. Returns how many were restored.
 fn untangle(mesh: &mut KeyedMesh, clip: &Aabb, spec: &GridSpec) -> u64 {
-    use crate::check::self_intersect::exact::{facets_intersect, Facet};
     use crate::geom::{cross, norm, sub};
+    use crate::verify::self_intersect::exact::{facets_intersect, Facet};
     use std::collections::HashMap;
     let on_clip = |p: Vec3| (0..3).any(|a| p[a] == clip.min[a] || p[a] == clip.max[a]);
     // The vertices in voxels holding more than one: two sheets pass through those.

@@ -21,7 +21,6 @@
 //! fragments dropped when it is meshed again, on the same tiles, to be written (a fragment is a
 //! whole closed shell: what stays is as closed as before).
 
-use crate::check::verify::Verify;
 use crate::error::Result;
 use crate::field::Aabb;
 use crate::geom::topology::UnionFind;
@@ -30,6 +29,7 @@ use crate::io::sink::{Measures, MeshSink, Triangle};
 use crate::mesh::extract::{KeyedMesh, VertexKey};
 use crate::mesh::pieces::{self, Fragments, Shells};
 use crate::progress::Progress;
+use crate::verify::Verify;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -459,14 +459,14 @@ fn tile_result(
         drop(index);
         let all: Vec<u32> = (0..patch.triangle_count() as u32).collect();
         let (_, pairs) = if verify == Verify::Cgal {
-            crate::check::self_intersect::cgal_soup_self_intersections(
+            crate::verify::self_intersect::cgal_soup_self_intersections(
                 &patch,
                 &all,
                 None,
                 usize::MAX,
             )?
         } else {
-            crate::check::self_intersect::soup_self_intersections(&patch, &all, usize::MAX)
+            crate::verify::self_intersect::soup_self_intersections(&patch, &all, usize::MAX)
         };
         pairs.iter().any(|&(f, g)| f.min(g) < kept_triangles)
     } else {

@@ -3,12 +3,13 @@
 
 use super::{repair, RepairOptions, RepairReport};
 use crate::check::deviation::{deviation, Deviation};
-use crate::check::{check, read_file, CheckOptions, CheckReport, Defects, Verdict};
+use crate::check::{check, read_file, CheckOptions, CheckReport, Defects};
 use crate::error::{Error, Result};
 use crate::geom::Mesh;
 use crate::io::{Format, ReadOptions, Reading};
 use crate::mesh::output::MeshFile;
 use crate::progress::Progress;
+use crate::verify::Verdict;
 use std::path::Path;
 
 /// Everything `latvox repair` reports.
@@ -40,7 +41,7 @@ pub struct FileRepairReport {
     /// The verdict on `after` (in JSON, the one flag `valid_solid`).
     #[serde(
         rename = "valid_solid",
-        serialize_with = "crate::check::verdict::valid_solid"
+        serialize_with = "crate::verify::verdict::valid_solid"
     )]
     pub verdict: Verdict,
 }

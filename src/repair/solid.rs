@@ -27,7 +27,6 @@
 //! compares every shell with every other.
 
 use super::remesh;
-use crate::check::self_intersect::soup_self_intersections;
 use crate::check::{check, CheckOptions};
 use crate::error::Error;
 use crate::error::Result;
@@ -35,6 +34,7 @@ use crate::ffi::cgal::ffi;
 use crate::ffi::Backend;
 use crate::geom::topology::{Shells, Topology, UnionFind};
 use crate::geom::Mesh;
+use crate::verify::self_intersect::soup_self_intersections;
 use std::time::{Duration, Instant};
 
 /// What making a solid did after the topological repair.

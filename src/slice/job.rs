@@ -7,13 +7,13 @@ use super::implicit::ImplicitSlicer;
 use super::mesh::{HeightIndex, MeshSlicer};
 use super::plan::{plan, Rule};
 use super::{Frame, Section, Stack, StackWriter};
-use crate::check::verify::{verify, Verify};
 use crate::check::{check, CheckOptions};
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Field, Vec3};
 use crate::geom::contour::{grow, merge, EMPTY_BOX};
 use crate::geom::Mesh;
 use crate::progress::Progress;
+use crate::verify::{verify, Verify};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 

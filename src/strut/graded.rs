@@ -130,7 +130,7 @@ pub(crate) fn calibrate(
         model: family.model.clone(),
     };
     let opts = Options {
-        verify: crate::check::verify::Verify::None,
+        verify: crate::verify::Verify::None,
         instancing: false,
         keep_fragments: true,
         ..*opts

@@ -5,7 +5,6 @@
 //! [`crate::mesh::pipeline`]'s, the resolution search [`crate::mesh::resolution`]'s.
 
 use super::{RadiusModel, StrutFamily, StrutLattice, UnitCell};
-use crate::check::Verdict;
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Domain};
 use crate::geom::Mesh;
@@ -16,6 +15,7 @@ use crate::mesh::pipeline::{self, Family, Measured, MeshingStats, Options, Route
 use crate::mesh::report::{LevelSearch, PartReport, Timings};
 use crate::mesh::resolution::{self, max_resolution, Resolved};
 use crate::progress::Progress;
+use crate::verify::Verdict;
 use std::sync::Arc;
 use std::time::Instant;
 

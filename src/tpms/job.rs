@@ -4,7 +4,6 @@
 
 use super::calibrate::{self, Calibration, Connectivity, FeasibleRange};
 use super::{Domain, Lattice, LatticeFamily, Structure, Surface};
-use crate::check::Verdict;
 use crate::error::{Error, Result};
 use crate::geom::Mesh;
 use crate::io::sink::{MeshCollector, MeshSink};
@@ -12,6 +11,7 @@ use crate::mesh::pipeline::{self, Options, Route, Solved};
 use crate::mesh::report::{LevelSearch, PartReport, Timings};
 use crate::mesh::resolution;
 use crate::progress::Progress;
+use crate::verify::Verdict;
 use std::time::Instant;
 
 pub use crate::mesh::pipeline::{Instancing, Tiling, DEFAULT_MEMORY};
@@ -40,7 +40,7 @@ pub struct TpmsJob {
     /// Raise the resolution when sheet walls would be thinner than [`MIN_WALL_VOXELS`].
     pub auto_resolution: bool,
     /// How the written part is verified.
-    pub verify: crate::check::verify::Verify,
+    pub verify: crate::verify::Verify,
     /// Copy a periodic part's cells from a meshed template where possible ([`instance`]);
     /// otherwise the whole part is meshed at once.
     pub instancing: bool,

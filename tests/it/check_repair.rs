@@ -604,7 +604,7 @@ fn torus(nu: usize, nv: usize, offset: P) -> Vec<Tri> {
 /// brute-forced.
 #[test]
 fn tiled_self_intersection_search_finds_the_pairs_of_the_whole_search() {
-    use latvox::check::self_intersect::soup_self_intersections_in_tiles;
+    use latvox::verify::self_intersect::soup_self_intersections_in_tiles;
     let data = cgal_data();
     let dir = tempdir();
     let mut tori = torus(40, 20, [0.0; 3]);
@@ -633,7 +633,7 @@ fn tiled_self_intersection_search_finds_the_pairs_of_the_whole_search() {
             .iter()
             .flat_map(|&f| mesh.indices[3 * f as usize..3 * f as usize + 3].to_vec())
             .collect();
-        let (faces, starts) = latvox::check::self_intersect::box_tiles(&mesh.positions, &soup, 1);
+        let (faces, starts) = latvox::verify::self_intersect::box_tiles(&mesh.positions, &soup, 1);
         if keep.len() > 100 {
             assert_eq!(starts.len(), 3, "{}", file.display());
             assert!(faces.len() < keep.len() * 3 / 2);
@@ -925,7 +925,7 @@ fn t_junction_box() -> Vec<Tri> {
 /// `does_self_intersect` (exact predicates), on the file read back as the next program reads it.
 fn assert_cgal_solid(name: &str, file: &Path) -> f64 {
     let loaded = latvox::io::read(file, &Default::default()).unwrap();
-    let v = latvox::check::cgal::verify(&loaded.mesh, true).unwrap();
+    let v = latvox::verify::cgal::verify(&loaded.mesh, true).unwrap();
     assert!(
         v.manifold && v.closed && v.outward && v.self_intersection_checked && !v.self_intersecting,
         "{name}: CGAL {v:?}"
@@ -1230,7 +1230,7 @@ fn random_boxes_unite_exactly_and_random_soups_never_fail() {
         }
         let tris: Vec<Tri> = boxes.iter().flat_map(|(lo, hi)| cuboid(*lo, *hi)).collect();
         let m = solid_of(&tris, None).unwrap_or_else(|e| panic!("case {case} {boxes:?}: {e}"));
-        let v = latvox::check::cgal::verify(&m, true).unwrap();
+        let v = latvox::verify::cgal::verify(&m, true).unwrap();
         let ctx = format!("case {case}: {boxes:?}: {v:?}");
         assert!(
             v.closed && v.outward && v.manifold && !v.self_intersecting,
@@ -1256,7 +1256,7 @@ fn random_boxes_unite_exactly_and_random_soups_never_fail() {
         let mesh = latvox::io::weld::weld_indexed(&positions, &indices).unwrap();
         latvox::check::check(&mesh, None, &Default::default())
             .unwrap_or_else(|e| panic!("soup {case} {tris:?}: check: {e}"));
-        latvox::check::cgal::verify(&mesh, true)
+        latvox::verify::cgal::verify(&mesh, true)
             .unwrap_or_else(|e| panic!("soup {case} {tris:?}: CGAL: {e}"));
         // (A soup 2 mm across remeshed at 1/20 mm: the automatic voxel is finer and slower.)
         match solid_of(&tris, Some(0.05)) {
@@ -1462,12 +1462,12 @@ fn mutated_meshes_never_reach_a_backend_error() {
         let mesh = latvox::io::weld::weld_indexed(&positions, &indices).unwrap();
         latvox::check::check(&mesh, None, &Default::default())
             .unwrap_or_else(|e| panic!("{ctx}: check: {e}"));
-        latvox::check::cgal::verify(&mesh, true).unwrap_or_else(|e| panic!("{ctx}: CGAL: {e}"));
+        latvox::verify::cgal::verify(&mesh, true).unwrap_or_else(|e| panic!("{ctx}: CGAL: {e}"));
         match solid_of(&tris, Some(0.1)) {
             Ok(m) => {
                 let c = latvox::check::check(&m, None, &Default::default()).unwrap();
                 assert!(c.defects().is_empty(), "{ctx}: {:?}", c.defects());
-                let v = latvox::check::cgal::verify(&m, true).unwrap();
+                let v = latvox::verify::cgal::verify(&m, true).unwrap();
                 assert!(v.closed && !v.self_intersecting, "{ctx}: {v:?}");
             }
             Err(e) => assert_eq!(e.exit_code(), 2, "{ctx}: {e}"),
@@ -1531,6 +1531,6 @@ fn a_shell_crossing_itself_is_remeshed_at_its_size() {
     let c = latvox::check::check(&m, None, &Default::default()).unwrap();
     assert!(c.defects().is_empty(), "{:?}", c.defects());
     assert_eq!(c.shell_count, 1);
-    let v = latvox::check::cgal::verify(&m, true).unwrap();
+    let v = latvox::verify::cgal::verify(&m, true).unwrap();
     assert!(v.closed && v.manifold && !v.self_intersecting, "{v:?}");
 }

@@ -39,7 +39,7 @@ fn hits_targets(all: bool) {
                     adaptivity: 0.0,
                     allow_islands: true,
                     auto_resolution: true,
-                    verify: latvox::check::verify::Verify::Full,
+                    verify: latvox::verify::Verify::Full,
                     instancing: true,
                     tile: None,
                     memory: None,

@@ -133,7 +133,7 @@ fn skin_job(points: Vec<[f64; 3]>, voxel: f64) -> FgmJob {
         composition: Composition::new(vec!["A".into(), "B".into()], vec![Law::Power { p: 1.0 }])
             .unwrap(),
         dmax: None,
-        verify: latvox::check::verify::Verify::Full,
+        verify: latvox::verify::Verify::Full,
     }
 }
 

@@ -8,12 +8,12 @@ use crate::meshkit;
 
 use crate::common::{tempdir, Rng};
 use crate::meshkit::{cgal_data, cuboid, write_stl, Tri};
-use latvox::check::cgal;
-use latvox::check::self_intersect::{cgal_soup_self_intersections, soup_self_intersections};
-use latvox::check::verify::{topology, verify, Verify};
 use latvox::geom::Mesh;
 use latvox::progress::Progress;
 use latvox::tpms::{Domain, Structure, Surface, TpmsJob};
+use latvox::verify::cgal;
+use latvox::verify::self_intersect::{cgal_soup_self_intersections, soup_self_intersections};
+use latvox::verify::{topology, verify, Verify};
 
 /// Both searches over every facet with three distinct vertices: same count, same pairs.
 fn same_pairs_as_cgal(mesh: &Mesh, what: &str) -> u64 {

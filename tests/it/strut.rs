@@ -64,7 +64,7 @@ fn built_in_cells(all: bool) {
                 resolution: 32,
                 auto_resolution: false,
                 options: Options {
-                    verify: latvox::check::verify::Verify::Cgal,
+                    verify: latvox::verify::Verify::Cgal,
                     instancing: true,
                     ..Default::default()
                 },

@@ -50,13 +50,13 @@ pub fn check_repair(data: &[u8]) {
     );
     step(
         "CGAL's checks",
-        latvox::check::cgal::verify(&mesh, true).map(drop),
+        latvox::verify::cgal::verify(&mesh, true).map(drop),
     );
     match repair(&mesh, &RepairOptions::default(), &Progress::hidden()) {
         Ok((m, _)) if m.triangle_count() > 0 => {
             let c = latvox::check::check(&m, None, &Default::default());
             step("check after repair", c.map(drop));
-            let v = latvox::check::cgal::verify(&m, true);
+            let v = latvox::verify::cgal::verify(&m, true);
             step("CGAL's checks after repair", v.map(drop));
         }
         Ok(_) => {}
@@ -78,7 +78,7 @@ pub fn check_repair(data: &[u8]) {
                 "repair --solid left {:?}",
                 c.defects()
             );
-            let v = latvox::check::cgal::verify(&m, true)
+            let v = latvox::verify::cgal::verify(&m, true)
                 .unwrap_or_else(|e| panic!("CGAL's checks of the solid: {e}"));
             assert!(
                 v.closed && !v.self_intersecting,

@@ -1,8 +1,7 @@
 //! The verdict every command gives on a mesh: is it a valid closed, outward solid? One type, one
 //! rule, one exit code, whichever check (latvox's own, CGAL's, or both) made the findings.
 
-use super::CheckReport;
-use crate::check::cgal::Verification;
+use crate::verify::cgal::Verification;
 
 /// What a check found on the properties that make a mesh a printable solid.
 ///
@@ -93,32 +92,6 @@ impl From<&Verification> for Verdict {
             self_intersection_checked: v.self_intersection_checked,
             self_intersecting: v.self_intersecting,
             sound_facets: true,
-            one_piece: None,
-            density_met: None,
-            features_printable: None,
-        }
-    }
-}
-
-impl From<&CheckReport> for Verdict {
-    /// latvox's own findings: valid exactly when [`CheckReport::defects`] is empty.
-    fn from(r: &CheckReport) -> Verdict {
-        let normals = r.normals.unwrap_or_default();
-        Verdict {
-            closed: r.boundary_edges == 0 && r.hole_loops == 0,
-            manifold: r.non_manifold_edges == 0 && r.non_manifold_vertices == 0,
-            outward: r.inconsistent_edges == 0
-                && r.inward_shells == 0
-                && r.non_orientable_shells == 0,
-            self_intersection_checked: r.self_intersections.is_some(),
-            self_intersecting: r.self_intersections.unwrap_or(0) > 0,
-            sound_facets: r.facets > 0
-                && r.repeated_vertex_facets == 0
-                && r.zero_area_facets == 0
-                && r.duplicate_facets == 0
-                && r.t_junctions == 0
-                && normals.reversed == 0
-                && normals.inaccurate == 0,
             one_piece: None,
             density_met: None,
             features_printable: None,

@@ -1,18 +1,32 @@
-//! Verification of every mesh latvox writes, at meshing speed: closed, manifold, consistently
-//! wound and facing out, free of self-intersections, with its volume and area — read off the
-//! vertex indices in linear time (each vertex's fan of facets), and the exact self-intersection
-//! search of [`crate::check::self_intersect`]. CGAL's Polygon Mesh Processing checks remain
-//! available ([`Verify::Cgal`]) as an independent second opinion, and are the oracle the tests
-//! compare these checks with.
+//! Verification: the proof that a mesh is a valid solid — closed, manifold, consistently wound
+//! and facing out, free of self-intersections — that every mesh latvox writes carries, with its
+//! volume and area. [`crate::check`] (above the meshing pipeline) counts every defect of any
+//! mesh instead; this stage only says whether the properties hold, fast enough to run on every
+//! part made.
+//!
+//! - [`verify`]: latvox's own checks at meshing speed, read off the vertex indices in linear
+//!   time (each vertex's fan of facets), and the exact self-intersection search of
+//!   [`self_intersect`] (a grid broad phase, CGAL's triangle tests on Shewchuk's predicates).
+//! - [`cgal`]: CGAL's Polygon Mesh Processing checks of the same properties
+//!   ([`Verify::Cgal`]): an independent second opinion, and the oracle the tests compare
+//!   latvox's checks with.
+//! - [`Verdict`]: the one rule every command applies to what the checks found (a valid closed,
+//!   outward solid, and the part's own targets met) and its exit code.
 
-use crate::check::cgal::Verification;
-use crate::check::self_intersect::fans::{fan, Links};
-use crate::check::self_intersect::{soup_self_intersections_shown, Stars};
+pub mod cgal;
+pub mod self_intersect;
+pub(crate) mod verdict;
+
+pub use verdict::Verdict;
+
 use crate::error::Result;
 use crate::geom::topology::UnionFind;
 use crate::geom::Mesh;
 use crate::geom::{cross, norm, ordered_sum, signed_volume, sub};
 use crate::progress::Progress;
+use crate::verify::cgal::Verification;
+use crate::verify::self_intersect::fans::{fan, Links};
+use crate::verify::self_intersect::{soup_self_intersections_shown, Stars};
 use rayon::prelude::*;
 
 /// How a made part is verified.
@@ -62,7 +76,7 @@ impl Verify {
 /// Verifies `mesh` as `how` asks; a bar counts the self-intersection search's progress.
 pub fn verify(mesh: &Mesh, how: Verify, progress: &Progress) -> Result<Verification> {
     match how {
-        Verify::Cgal => crate::check::cgal::verify(mesh, true),
+        Verify::Cgal => crate::verify::cgal::verify(mesh, true),
         Verify::None => Ok(unchecked(mesh)),
         Verify::Full => {
             // The fans are checked beside the search's bucketing (it needs their star vertices
@@ -173,7 +187,7 @@ struct VertexFans {
     /// Vertices used by some facet.
     used: u64,
     /// Per vertex, when asked for: its closed fan projects one-to-one onto an axis plane (see
-    /// [`crate::check::self_intersect::fans`]); empty otherwise.
+    /// [`crate::verify::self_intersect::fans`]); empty otherwise.
     star: Vec<bool>,
 }
 

@@ -2,11 +2,11 @@
 //! computed by CGAL's Polygon Mesh Processing on a Surface_mesh built from our triangles —
 //! an independent second measurement of every mesh latvox writes.
 
-use crate::check::Verdict;
 use crate::error::Result;
 use crate::ffi::cgal::ffi;
 use crate::ffi::Backend;
 use crate::geom::Mesh;
+use crate::verify::Verdict;
 
 /// What CGAL found.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
