@@ -65,6 +65,7 @@ pub mod geom;
 pub mod grid;
 pub mod interpret;
 pub mod io;
+pub mod lattice;
 pub mod mesh;
 pub mod progress;
 pub mod render;

@@ -72,7 +72,7 @@ pub fn run(a: &ViewArgs) -> Result<i32> {
         scene: Box::new(move |t| {
             Ok(match part_of_table(t, &scene_path)? {
                 Part::Block(m) => Scene::of(&m),
-                Part::Filled(traced) => Scene::of_filled(&traced),
+                Part::Filled(traced) => traced.editor_scene(),
             })
         }),
         save: Box::new(super::part::write),

@@ -13,6 +13,11 @@ use super::shape::{FillFamily, FillSolid, Infill, Shape};
 use crate::error::Result;
 use crate::field::{Aabb, Vec3};
 use crate::io::sink::MeshSink;
+use crate::lattice::strut::MIN_STRUT_VOXELS;
+use crate::lattice::strut::{RadiusModel, StrutFamily, StrutLattice};
+use crate::lattice::tpms::graded::Calibrated;
+use crate::lattice::tpms::MIN_WALL_VOXELS;
+use crate::lattice::tpms::{calibrate, Lattice, Structure};
 use crate::mesh::cells::CellVolumes;
 use crate::mesh::graded::{
     self, Cells, Feasible, Graded, GradedFamily, Grading, LevelGrid, LevelMap, Levelled, Run,
@@ -21,11 +26,6 @@ use crate::mesh::pipeline::Options;
 use crate::mesh::report::Timings;
 use crate::mesh::resolution::max_resolution;
 use crate::progress::Progress;
-use crate::strut::job::MIN_STRUT_VOXELS;
-use crate::strut::{RadiusModel, StrutFamily, StrutLattice};
-use crate::tpms::graded::Calibrated;
-use crate::tpms::job::MIN_WALL_VOXELS;
-use crate::tpms::{calibrate, Lattice, Structure};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -251,7 +251,7 @@ impl FillJob {
             Kind::Strut(f) => {
                 let (map, met) = {
                     let _p = progress.stage("calibrating the density → radius map");
-                    crate::strut::graded::calibrate(&f, voxel, &opts, lo, hi)?
+                    crate::lattice::strut::graded::calibrate(&f, voxel, &opts, lo, hi)?
                 };
                 let kind = filled(f.with_bounds(bounds), map, &shape, self, base, whole);
                 run(met, cal_start.elapsed().as_secs_f64())

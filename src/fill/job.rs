@@ -11,16 +11,16 @@ use crate::error::{Error, Result};
 use crate::field::{Aabb, Vec3};
 use crate::geom::Mesh;
 use crate::io::sink::{MeshCollector, MeshSink};
+use crate::lattice::strut::MIN_STRUT_VOXELS;
+use crate::lattice::strut::{RadiusModel, StrutFamily, StrutLattice, UnitCell};
+use crate::lattice::tpms::MIN_WALL_VOXELS;
+use crate::lattice::tpms::{calibrate, Lattice, LatticeFamily, Structure, Surface};
 use crate::mesh::graded::{Grading, GradingReport};
 use crate::mesh::pipeline::{self, Family, Measured, MeshingStats, Options, Route};
 use crate::mesh::report::{LevelSearch, PartReport, Timings};
 use crate::mesh::resolution::{self, Resolved};
 use crate::progress::Progress;
 use crate::repair::{repair, Change, RepairOptions};
-use crate::strut::job::MIN_STRUT_VOXELS;
-use crate::strut::{RadiusModel, StrutFamily, StrutLattice, UnitCell};
-use crate::tpms::job::MIN_WALL_VOXELS;
-use crate::tpms::{calibrate, Lattice, LatticeFamily, Structure, Surface};
 use crate::verify::Verdict;
 use std::sync::Arc;
 use std::time::Instant;
@@ -238,7 +238,7 @@ impl FillJob {
         opts: &Options,
         progress: &Progress,
     ) -> Result<(f64, f64, MeshingStats)> {
-        let solid = |infill| FillSolid::<crate::tpms::Lattice> {
+        let solid = |infill| FillSolid::<crate::lattice::tpms::Lattice> {
             shape: shape.clone(),
             skin: self.skin,
             blend: self.blend,

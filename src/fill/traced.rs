@@ -14,13 +14,14 @@ use crate::field::{intersection_clearance, union_clearance, Aabb, Field, Vec3};
 use crate::geom::bvh::Bvh;
 use crate::geom::{norm, sub};
 use crate::grid::GridSpec;
+use crate::lattice::strut::{RadiusModel, StrutLattice};
+use crate::lattice::tpms::{calibrate, Lattice};
 use crate::render::camera::{dot, Ray};
 use crate::render::trace::{
     field_normal, field_openness, mesh_hit, sphere_trace, Hit, Scene, Section, Tolerance,
 };
+use crate::render::view::scene::{Fill, Scene as EditorScene, Triangles};
 use crate::render::Periodic;
-use crate::strut::{RadiusModel, StrutLattice};
-use crate::tpms::{calibrate, Lattice};
 
 /// A filled part as meshes and a lattice, ready to trace.
 pub struct Traced {
@@ -112,6 +113,41 @@ impl FillJob {
 }
 
 impl Traced {
+    /// The browser editor's scene of the filled part: the lattice inside, the part's surface,
+    /// its skin, drains and kept solids.
+    pub fn editor_scene(&self) -> EditorScene {
+        let mut scene = EditorScene::of_lattice(
+            self.lattice(),
+            self.level,
+            self.reach(),
+            self.bounds,
+            self.voxel,
+            self.cell,
+        );
+        let keep: Vec<[Vec3; 3]> = self
+            .keep()
+            .iter()
+            .flat_map(|k| k.triangles().iter().copied())
+            .collect();
+        let (skin, blend) = self.skin_and_blend();
+        scene.fill = Some(Fill {
+            part: Triangles::of(self.part()),
+            keep: Triangles::of(&Bvh::over(keep)),
+            drains: self
+                .drains()
+                .iter()
+                .map(|d| {
+                    let (a, b) = (d.from, d.to);
+                    [a[0], a[1], a[2], b[0], b[1], b[2], d.radius]
+                })
+                .collect(),
+            skin,
+            blend,
+            cap: skin + blend + self.reach() + self.voxel,
+        });
+        scene
+    }
+
     /// The distance up to which the lattice's field is exact (see [`crate::render::Model`]).
     pub fn reach(&self) -> f64 {
         0.15 * self.cell

@@ -67,9 +67,9 @@ impl Model {
 #[derive(Debug, Clone)]
 pub enum Periodic {
     /// A TPMS lattice.
-    Tpms(crate::tpms::Lattice),
+    Tpms(crate::lattice::tpms::Lattice),
     /// A strut lattice.
-    Struts(crate::strut::StrutLattice),
+    Struts(crate::lattice::strut::StrutLattice),
 }
 
 impl Periodic {

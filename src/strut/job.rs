@@ -19,11 +19,7 @@ use crate::verify::Verdict;
 use std::sync::Arc;
 use std::time::Instant;
 
-/// Struts thinner than this many voxels across are not represented faithfully by a narrow
-/// band: stretches of the strut hold no sample inside it, and it breaks (an octet truss at 1.6
-/// voxels across falls into thousands of pieces; at 1.8 and up every built-in cell stays
-/// whole). The resolution is raised to keep struts this thick.
-pub const MIN_STRUT_VOXELS: f64 = 2.0;
+pub use crate::lattice::strut::MIN_STRUT_VOXELS;
 
 /// How thick the struts are: made to a volume fraction, or given.
 #[derive(Debug, Clone, Copy, PartialEq)]

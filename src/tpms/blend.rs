@@ -10,12 +10,12 @@
 //! tabulated at five weights and interpolated between them — less the meshing's bias calibrated
 //! on each type at the part's voxels; each whole cell is then measured on the mesh and corrected.
 
-use super::graded::Calibrated;
 use super::{Lattice, Structure, Surface, TpmsField};
 use crate::field::density::DensityField;
 use crate::field::nodes::Nodes;
 use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
+use crate::lattice::tpms::graded::Calibrated;
 use crate::mesh::graded::{self, Graded, GradedFamily, LevelGrid, LevelMap, Levelled};
 use std::sync::Arc;
 

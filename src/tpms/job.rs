@@ -16,9 +16,7 @@ use std::time::Instant;
 
 pub use crate::mesh::pipeline::{Instancing, Tiling, DEFAULT_MEMORY};
 
-/// Sheet walls thinner than this many voxels are not represented faithfully by a narrow band
-/// (samples miss the wall and it perforates); the resolution is raised to keep them this thick.
-pub const MIN_WALL_VOXELS: f64 = 1.25;
+pub use crate::lattice::tpms::MIN_WALL_VOXELS;
 
 /// What to build.
 #[derive(Debug, Clone)]

@@ -1,10 +1,9 @@
 //! A part as the editor's shader draws it: the numbers its uniforms and strut texture take.
 
 use crate::field::{Aabb, Vec3};
-use crate::fill::traced::Traced;
 use crate::geom::bvh::Bvh;
+use crate::lattice::tpms::Structure;
 use crate::render::{Model, Periodic};
-use crate::tpms::Structure;
 use serde::Serialize;
 
 /// How far above the part's radius the page's radius control reaches: the strut list is built
@@ -47,7 +46,8 @@ pub struct Triangles {
 }
 
 impl Triangles {
-    fn of(bvh: &Bvh) -> Triangles {
+    /// The BVH's nodes and triangles.
+    pub fn of(bvh: &Bvh) -> Triangles {
         Triangles {
             nodes: bvh.nodes().iter().map(|n| n.map(|x| x as f32)).collect(),
             triangles: bvh
@@ -119,7 +119,7 @@ pub struct Struts {
 impl Scene {
     /// The scene of a TPMS or strut part.
     pub fn of(model: &Model) -> Scene {
-        Scene::lattice(
+        Scene::of_lattice(
             &model.lattice,
             model.level,
             model.reach(),
@@ -129,41 +129,10 @@ impl Scene {
         )
     }
 
-    /// The scene of a filled part.
-    pub fn of_filled(traced: &Traced) -> Scene {
-        let mut scene = Scene::lattice(
-            traced.lattice(),
-            traced.level,
-            traced.reach(),
-            traced.bounds,
-            traced.voxel,
-            traced.cell,
-        );
-        let keep: Vec<[Vec3; 3]> = traced
-            .keep()
-            .iter()
-            .flat_map(|k| k.triangles().iter().copied())
-            .collect();
-        let (skin, blend) = traced.skin_and_blend();
-        scene.fill = Some(Fill {
-            part: Triangles::of(traced.part()),
-            keep: Triangles::of(&Bvh::over(keep)),
-            drains: traced
-                .drains()
-                .iter()
-                .map(|d| {
-                    let (a, b) = (d.from, d.to);
-                    [a[0], a[1], a[2], b[0], b[1], b[2], d.radius]
-                })
-                .collect(),
-            skin,
-            blend,
-            cap: skin + blend + traced.reach() + traced.voxel,
-        });
-        scene
-    }
-
-    fn lattice(
+    /// The scene of a lattice at `level` (distances exact up to `reach`), clipped by `bounds`,
+    /// meshed at `voxel` in cells whose shortest side is `cell`; a filled part adds its
+    /// [`Fill`].
+    pub fn of_lattice(
         lattice: &Periodic,
         level: f64,
         reach: f64,
@@ -214,7 +183,7 @@ impl Scene {
             }
             Periodic::Struts(l) => {
                 let max_radius = RADIUS_SPAN * l.radius;
-                let wide = crate::strut::StrutLattice {
+                let wide = crate::lattice::strut::StrutLattice {
                     radius: max_radius,
                     ..l.clone()
                 };
@@ -234,7 +203,7 @@ impl Scene {
                 scene.struts = Some(Struts {
                     struts,
                     bins,
-                    bins_per_axis: crate::strut::field::BINS,
+                    bins_per_axis: crate::lattice::strut::field::BINS,
                     blend: l.blend,
                     max_radius,
                     size: l.size,

@@ -102,7 +102,7 @@ fn segment_box_distance(p: Vec3, q: Vec3, b: &Aabb) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::strut::UnitCell;
+    use crate::lattice::strut::UnitCell;
     use std::sync::Arc;
 
     #[test]
