@@ -4,6 +4,7 @@
 use super::command::{parsed, Command};
 use super::part::{absolute, is_part_file, part_of_table, read, Part};
 use clap::Args;
+use latvox::render::view::guard::{Folder, Token};
 use latvox::render::view::scene::Scene;
 use latvox::render::view::{serve, Editor, Hooks};
 use latvox::{Error, Result};
@@ -15,8 +16,15 @@ Examples:
   # A gyroid part, then its editor: open the URL printed on the first line in a browser
   latvox tpms --type gyroid --density 0.3 --cells 4 -o gyroid.stl --save-part gyroid.toml
   latvox view gyroid.toml
+  # prints http://127.0.0.1:PORT/?token=T — the token is the key: keep the whole URL
 
-  # A strut part on a fixed port (e.g. forwarded over SSH from a cluster's login node)
+  # Meshes, slices and saved parts written in another folder than the part file's
+  latvox view gyroid.toml --out-dir runs/today
+
+  # A strut part on a cluster's login node: the server stays on the node's loopback; an SSH
+  # tunnel from this machine brings the port here (run ssh here, latvox there, open the
+  # printed URL, token and all, in a browser here)
+  ssh -L 8080:127.0.0.1:8080 login-node
   latvox strut --cell octet --density 0.2 --cells 5 -o octet.stl --save-part octet.toml
   latvox view octet.toml --port 8080
 
@@ -31,8 +39,14 @@ part's shell, cast at through its BVH — so a part of a million cells draws as 
 ten. Drag to turn it, scroll to zoom; the controls edit the part (type, structure, cell or
 lattice, cell size, density or radius, skin, blend, drains, the box) and cut it with a section
 plane. \"Save part\" writes the part file; \"Mesh\" and \"Slice\" run latvox on the
-saved settings and show their progress. The server listens on 127.0.0.1 only and serves until
-it is stopped (Ctrl-C).";
+saved settings and show their progress.
+
+The server listens on 127.0.0.1 only and serves until it is stopped (Ctrl-C). It obeys only
+the page opened with its URL: each run draws a new secret token, and a request without it, one
+naming another host than 127.0.0.1, localhost or [::1] with the port (DNS rebinding), or one
+sent by another site's page is refused. The page writes only inside the part file's folder, or
+the folder given with --out-dir (names relative to it; `..` and links leading out refused); the
+files a part reads (the mesh a fill part fills) are read where the part file names them.";
 
 /// `latvox view`.
 pub(crate) const COMMAND: Command = Command::new(
@@ -51,6 +65,10 @@ pub struct ViewArgs {
     /// The port to listen on (0: a free one).
     #[arg(long, default_value_t = 0)]
     pub port: u16,
+    /// The folder the page writes part files, meshes and slices in (made if missing; default:
+    /// the part file's folder). Nothing is written outside it.
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: Option<PathBuf>,
 }
 
 pub fn run(a: &ViewArgs) -> Result<i32> {
@@ -82,30 +100,49 @@ pub fn run(a: &ViewArgs) -> Result<i32> {
     let choices = super::command::find(&command)
         .and_then(|c| c.choices)
         .map_or(serde_json::Value::Null, |choices| choices());
-    let server = tiny_http::Server::http(("127.0.0.1", a.port))
+    let listener = std::net::TcpListener::bind(("127.0.0.1", a.port))
         .map_err(|e| Error::invalid(format!("cannot listen on 127.0.0.1:{}: {e}", a.port)))?;
-    let port = server
-        .server_addr()
-        .to_ip()
-        .map(|s| s.port())
-        .ok_or_else(|| Error::invalid("the server has no IP address"))?;
+    let port = listener
+        .local_addr()
+        .map_err(|e| Error::io("127.0.0.1", e))?
+        .port();
+    let folder = match &a.out_dir {
+        Some(dir) => {
+            if dir.exists() && !dir.is_dir() {
+                return Err(Error::invalid(format!(
+                    "{}: --out-dir names a file, not a folder",
+                    dir.display()
+                )));
+            }
+            std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+            Folder::new(dir)?
+        }
+        None => Folder::new(match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => std::path::Path::new("."),
+        })?,
+    };
+    let token = Token::new()?;
     let exe = std::env::current_exe().map_err(|e| Error::io("latvox", e))?;
     let mut out = std::io::stdout();
-    let _ = writeln!(out, "http://127.0.0.1:{port}/");
+    let _ = writeln!(out, "http://127.0.0.1:{port}/?token={}", token.as_str());
     let _ = writeln!(
         out,
-        "latvox view: editing {} ({command}); stop with Ctrl-C",
-        path.display()
+        "latvox view: editing {} ({command}), writing in {}; stop with Ctrl-C",
+        path.display(),
+        folder.root().display()
     );
     let _ = out.flush();
     serve(
-        server,
+        listener,
         Editor {
             path,
             settings,
             choices,
             exe,
             hooks,
+            folder,
+            token,
         },
     )?;
     Ok(0)

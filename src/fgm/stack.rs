@@ -116,7 +116,7 @@ pub fn write(fgm: &Fgm, dir: &Path, spec: &StackSpec, progress: &Progress) -> Re
         layers,
         top,
     } = plan(fgm, spec)?;
-    let out = AtomicDir::create(dir)?;
+    let out = AtomicDir::create(dir, "stack.json")?;
     let counter = progress.counter(layers as u64, "layers");
     let results: Vec<Result<LayerCounts>> = (0..layers)
         .into_par_iter()

@@ -202,19 +202,34 @@ impl AtomicFile {
 }
 
 /// A folder filled file by file and put in place whole: a temporary folder beside the target
-/// until [`AtomicDir::commit`], which replaces the target folder (and what it held).
+/// until [`AtomicDir::commit`], which replaces the target folder (and what it held). Only a
+/// folder of the same kind is replaced — one holding the kind's mark file, as a previous write
+/// left it — or an empty one: a folder of other files named by mistake (the part's own folder,
+/// a home folder) is refused, never deleted.
 pub struct AtomicDir {
     path: std::path::PathBuf,
     tmp: tempfile::TempDir,
 }
 
 impl AtomicDir {
-    /// Starts filling the folder `path` (its parent must exist; `path` itself may exist, as a
-    /// folder, and is replaced on commit).
-    pub fn create(path: &Path) -> Result<AtomicDir> {
+    /// Starts filling the folder `path` (its parent must exist; `path` itself may exist, as an
+    /// empty folder or one holding the file `mark` that every such folder holds, and is
+    /// replaced on commit).
+    pub fn create(path: &Path, mark: &str) -> Result<AtomicDir> {
         if path.exists() && !path.is_dir() {
             return Err(Error::invalid(format!(
                 "{}: exists and is not a folder",
+                path.display()
+            )));
+        }
+        let empty = match std::fs::read_dir(path) {
+            Ok(mut entries) => entries.next().is_none(),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => true,
+            Err(e) => return Err(Error::io(path, e)),
+        };
+        if !empty && !path.join(mark).is_file() {
+            return Err(Error::invalid(format!(
+                "{}: the folder holds other files (no {mark}): name a new or empty folder",
                 path.display()
             )));
         }
@@ -258,5 +273,61 @@ impl AtomicDir {
         std::fs::rename(&tmp, &self.path).map_err(err)?;
         drop(old);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_folder_of_other_files_is_refused_not_replaced() {
+        let d = tempfile::tempdir().unwrap();
+        let mine = d.path().join("mine");
+        std::fs::create_dir(&mine).unwrap();
+        std::fs::write(mine.join("notes.txt"), "keep").unwrap();
+        let e = AtomicDir::create(&mine, "stack.json").err().unwrap();
+        assert!(e.to_string().contains("holds other files"), "{e}");
+        assert_eq!(
+            std::fs::read_to_string(mine.join("notes.txt")).unwrap(),
+            "keep"
+        );
+
+        // An empty folder, and a stack written before, are replaced whole.
+        for (name, old) in [("empty", None), ("stack", Some("stack.json"))] {
+            let p = d.path().join(name);
+            std::fs::create_dir(&p).unwrap();
+            if let Some(f) = old {
+                std::fs::write(p.join(f), "{}").unwrap();
+                std::fs::write(p.join("layer0.png"), "old").unwrap();
+            }
+            let dir = AtomicDir::create(&p, "stack.json").unwrap();
+            std::fs::write(dir.file("stack.json"), "new").unwrap();
+            dir.commit().unwrap();
+            assert_eq!(
+                std::fs::read_to_string(p.join("stack.json")).unwrap(),
+                "new"
+            );
+            assert!(!p.join("layer0.png").exists());
+        }
+    }
+
+    /// A link where an output goes is replaced by the output, never written through: what it
+    /// pointed at is untouched.
+    #[cfg(unix)]
+    #[test]
+    fn a_link_at_an_output_is_replaced_not_followed() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("theirs.txt");
+        std::fs::write(&target, "theirs").unwrap();
+        let out = d.path().join("out.stl");
+        std::os::unix::fs::symlink(&target, &out).unwrap();
+        write_atomic(&out, |w| w.write_all(b"mine")).unwrap();
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "theirs");
+        assert!(!std::fs::symlink_metadata(&out)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "mine");
     }
 }

@@ -104,7 +104,7 @@ impl LayerDir {
             std::fs::create_dir_all(path).map_err(|e| Error::io(path, e))?;
             None
         } else {
-            Some(AtomicDir::create(path)?)
+            Some(AtomicDir::create(path, "stack.json")?)
         };
         Ok(LayerDir {
             path: path.to_path_buf(),

@@ -810,6 +810,58 @@ fn batch_jobs_slice_and_resume() {
     assert_eq!(status(d), ["skipped", "skipped"]);
 }
 
+/// A folder of layers replaces only an empty folder or a stack written before: a folder of
+/// other files named as the output — by a command line or by a job file, the job file's own
+/// folder included — is refused with its files kept.
+#[test]
+fn a_folder_of_other_files_is_never_replaced_by_layers() {
+    let dir = tempdir();
+    let d = dir.path();
+    meshkit::write_stl(&d.join("ball.stl"), &meshkit::sphere(5.0, 24));
+    std::fs::create_dir(d.join("notes")).unwrap();
+    std::fs::write(d.join("notes/keep.txt"), "mine").unwrap();
+    let r = run(
+        &[
+            "slice", "ball.stl", "-o", "notes/", "--pixel", "0.2", "--layer", "0.5",
+        ],
+        d,
+    );
+    assert_eq!(
+        r.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(err.contains("holds other files"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(d.join("notes/keep.txt")).unwrap(),
+        "mine"
+    );
+
+    let jobs = "[[job]]\ncommand = \"slice\"\ninput = \"ball.stl\"\noutput = \".\"\n\
+                report = \"r.json\"\npixel = 0.2\nlayer = 0.5\n";
+    std::fs::write(d.join("jobs.toml"), jobs).unwrap();
+    let r = run(&["batch", "jobs.toml", "-q"], d);
+    assert_eq!(
+        r.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    assert_eq!(std::fs::read_to_string(d.join("jobs.toml")).unwrap(), jobs);
+    assert!(d.join("ball.stl").is_file() && d.join("notes/keep.txt").is_file());
+    let summary = json(&d.join("jobs-summary.json"));
+    let e = summary["jobs"][0]["error"].as_str().unwrap_or_default();
+    assert!(e.contains("holds other files"), "{summary}");
+
+    // A stack written before is replaced whole.
+    ok(d, "slice ball.stl -o masks/ --pixel 0.2 --layer 0.5");
+    ok(d, "slice ball.stl -o masks/ --pixel 0.2 --layer 1");
+    assert!(d.join("masks/layer00009.png").is_file());
+    assert!(!d.join("masks/layer00010.png").exists());
+}
+
 /// A right-handed frame `(u, v)` across the unit direction `d` (any will do: areas do not
 /// depend on it).
 fn across(d: [f64; 3]) -> ([f64; 3], [f64; 3]) {

@@ -3,13 +3,17 @@
 //! `latvox render` draws on the CPU from the same camera; the page's edits re-render and its
 //! saved part file renders as the page drew it. The server's API is spoken to directly over
 //! HTTP: bad requests get 4xx answers and the server goes on; meshing and slicing from it make
-//! the files the commands make.
+//! the files the commands make. It obeys only its page: requests without the run's token, naming
+//! another host, or sent by another site's page are refused, names leading out of its folder
+//! are refused with nothing written, slow clients do not hold it, and random requests neither
+//! stop it nor write outside its folder.
 
 use crate::common::*;
 use crate::meshkit;
+use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader, Read, Write};
-use std::net::TcpStream;
-use std::path::Path;
+use std::net::{Shutdown, TcpStream};
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -17,6 +21,7 @@ use std::time::{Duration, Instant};
 struct Server {
     child: Child,
     port: u16,
+    token: String,
 }
 
 impl Drop for Server {
@@ -26,10 +31,24 @@ impl Drop for Server {
     }
 }
 
+/// A request's headers, name and value.
+type Headers = Vec<(String, String)>;
+
+/// An answer: status, head (lower-cased) and body.
+struct Answer {
+    status: u16,
+    head: String,
+    body: String,
+}
+
 impl Server {
     fn start(part: &str, dir: &Path) -> Server {
+        Server::start_with(&["view", part], dir)
+    }
+
+    fn start_with(args: &[&str], dir: &Path) -> Server {
         let mut child = latvox()
-            .args(["view", part])
+            .args(args)
             .current_dir(dir)
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
@@ -39,42 +58,73 @@ impl Server {
         BufReader::new(child.stdout.take().unwrap())
             .read_line(&mut line)
             .unwrap();
-        // The first line is the URL, and nothing else.
-        let port = line
+        // The first line is the URL with the run's token, and nothing else.
+        let (port, token) = line
             .trim()
             .strip_prefix("http://127.0.0.1:")
-            .and_then(|r| r.strip_suffix('/'))
-            .and_then(|p| p.parse().ok())
+            .and_then(|r| r.split_once("/?token="))
+            .and_then(|(p, t)| Some((p.parse().ok()?, t.to_string())))
             .unwrap_or_else(|| panic!("the first line is not the URL: {line:?}"));
-        Server { child, port }
+        assert!(
+            token.len() >= 32 && token.bytes().all(|b| b.is_ascii_hexdigit()),
+            "{token}: not 128 bits or more"
+        );
+        Server { child, port, token }
     }
 
     fn url(&self) -> String {
-        format!("http://127.0.0.1:{}/", self.port)
+        format!("http://127.0.0.1:{}/?token={}", self.port, self.token)
     }
 
-    /// One HTTP request: the status and the body.
+    /// The headers the page sends: this server's host and the token.
+    fn page_headers(&self) -> Headers {
+        vec![
+            ("Host".into(), format!("127.0.0.1:{}", self.port)),
+            ("Authorization".into(), format!("token {}", self.token)),
+        ]
+    }
+
+    /// One HTTP request as the page makes it: the status and the body.
     fn ask(&self, method: &str, path: &str, body: &str) -> (u16, String) {
-        let mut s = TcpStream::connect(("127.0.0.1", self.port)).unwrap();
-        s.set_read_timeout(Some(Duration::from_secs(120))).unwrap();
-        write!(
-            s,
-            "{method} {path} HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n{body}",
+        let mut headers = self.page_headers();
+        headers.push(("Content-Type".into(), "application/json".into()));
+        let a = self.send(method, path, &headers, body);
+        (a.status, a.body)
+    }
+
+    /// One request with exactly `headers` (and Content-Length).
+    fn send(&self, method: &str, path: &str, headers: &[(String, String)], body: &str) -> Answer {
+        let mut raw = format!("{method} {path} HTTP/1.1\r\n");
+        for (k, v) in headers {
+            raw.push_str(&format!("{k}: {v}\r\n"));
+        }
+        raw.push_str(&format!(
+            "Connection: close\r\nContent-Length: {}\r\n\r\n{body}",
             body.len()
-        )
-        .unwrap();
-        let mut answer = String::new();
-        s.read_to_string(&mut answer).unwrap();
+        ));
+        let answer = self.raw(raw.as_bytes());
         let status = answer
             .split(' ')
             .nth(1)
             .and_then(|c| c.parse().ok())
             .unwrap_or_else(|| panic!("no status: {answer:?}"));
-        let body = answer
-            .split_once("\r\n\r\n")
-            .map_or("", |(_, b)| b)
-            .to_string();
-        (status, body)
+        let (head, body) = answer.split_once("\r\n\r\n").unwrap_or((&answer, ""));
+        Answer {
+            status,
+            head: head.to_ascii_lowercase(),
+            body: body.to_string(),
+        }
+    }
+
+    /// Sends `bytes` as they are, then reads the answer to its end.
+    fn raw(&self, bytes: &[u8]) -> String {
+        let mut s = TcpStream::connect(("127.0.0.1", self.port)).unwrap();
+        s.set_read_timeout(Some(Duration::from_secs(120))).unwrap();
+        // A server that answers before reading all (a refusal) may close first: not an error.
+        let _ = s.write_all(bytes);
+        let mut answer = Vec::new();
+        let _ = s.read_to_end(&mut answer);
+        String::from_utf8_lossy(&answer).into_owned()
     }
 
     fn json(&self, method: &str, path: &str, body: &str) -> (u16, serde_json::Value) {
@@ -282,6 +332,63 @@ fn the_page_draws_the_part_as_render_does() {
     }
 }
 
+/// The page, in headless Chromium, meshes and slices its part through its buttons: the jobs
+/// end done, in the part's folder, with the files `latvox` makes.
+#[test]
+fn the_page_meshes_and_slices() {
+    let d = tempdir();
+    let root = d.path().canonicalize().unwrap();
+    make_part(
+        &root,
+        &[
+            "tpms",
+            "--type",
+            "gyroid",
+            "--density",
+            "0.3",
+            "--cells",
+            "2",
+            "--cell-size",
+            "5",
+            "--resolution",
+            "16",
+        ],
+    );
+    let server = Server::start("part.toml", &root);
+    let args = [
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--mesh",
+        "m.stl",
+        "--slice",
+        "layers.cli",
+        "--layer",
+        "0.5",
+    ];
+    let Some(seen) = drive(&server.url(), &root, &args) else {
+        return;
+    };
+    assert_eq!(seen["error"], serde_json::Value::Null, "{seen}");
+    assert_eq!(seen["page_errors"], serde_json::json!([]), "{seen}");
+    let mesh = &seen["meshing"];
+    assert_eq!(mesh["state"], "done", "{seen}");
+    assert_eq!(mesh["output"], root.join("m.stl").display().to_string());
+    let density = mesh["report"]["achieved_density"].as_f64().unwrap();
+    assert!((density - 0.3).abs() < 0.01, "{seen}");
+    let vol = volume(&read_stl(&root.join("m.stl")));
+    assert!((vol / 1000.0 - density).abs() < 0.002, "{vol}");
+    let slice = &seen["slicing"];
+    assert_eq!(slice["state"], "done", "{seen}");
+    assert_eq!(
+        slice["output"],
+        root.join("layers.cli").display().to_string()
+    );
+    assert_eq!(slice["report"]["layers"], 20, "{seen}");
+    assert!(root.join("layers.cli").is_file());
+}
+
 /// The share of pixels both pictures hit where the colours agree within 24 levels a channel.
 fn colour_agreement(page: &[u8], cpu: &[u8], cpu_hit: &[bool], page_hit: &[bool]) -> f64 {
     let (mut both, mut alike) = (0usize, 0usize);
@@ -449,7 +556,7 @@ fn wait(server: &Server) -> serde_json::Value {
 
 /// What the editor cannot open is refused: exit 2, one line, nothing served or written — a
 /// mesh, a missing file, a setting out of range, a filled part whose shell mesh is gone, a port
-/// that does not exist.
+/// that does not exist, an output folder that is a file.
 #[test]
 fn the_editor_refuses_what_it_cannot_open() {
     let d = tempdir();
@@ -471,6 +578,10 @@ fn the_editor_refuses_what_it_cannot_open() {
         (&["view", "bad.toml"], "density"),
         (&["view", "fill.toml"], "gone.stl"),
         (&["view", "part.toml", "--port", "70000"], "70000"),
+        (
+            &["view", "part.toml", "--out-dir", "part.stl"],
+            "not a folder",
+        ),
     ] {
         // A server that starts where it should refuse is stopped, not waited for.
         let mut child = latvox()
@@ -491,4 +602,671 @@ fn the_editor_refuses_what_it_cannot_open() {
         let out = child.wait_with_output().unwrap();
         assert_refusal(d.path(), &before, &out, args, what);
     }
+}
+
+/// Every file and link under `dir`, with its contents or target: what a refused request must
+/// leave as it was.
+fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut all = BTreeMap::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            let m = std::fs::symlink_metadata(&p).unwrap();
+            let seen = if m.file_type().is_symlink() {
+                let to = std::fs::read_link(&p).unwrap();
+                format!("link to {}", to.display()).into_bytes()
+            } else if m.is_dir() {
+                todo.push(p.clone());
+                b"folder".to_vec()
+            } else {
+                std::fs::read(&p).unwrap()
+            };
+            all.insert(p, seen);
+        }
+    }
+    all
+}
+
+/// A part in `root/part/` (with a folder `sub`), beside `root/outside/` holding one file, with links in the part's
+/// folder leading out: a folder (`out`), an existing file (`there.toml`) and a file not yet
+/// made (`gone.toml`).
+fn part_beside_outside(root: &Path) -> PathBuf {
+    let part = root.join("part");
+    let outside = root.join("outside");
+    std::fs::create_dir_all(part.join("sub")).unwrap();
+    std::fs::create_dir_all(&outside).unwrap();
+    make_part(
+        &part,
+        &[
+            "tpms",
+            "--type",
+            "gyroid",
+            "--density",
+            "0.3",
+            "--cells",
+            "1",
+            "--cell-size",
+            "4",
+            "--resolution",
+            "12",
+        ],
+    );
+    std::fs::write(outside.join("there.toml"), "# theirs\n").unwrap();
+    std::os::unix::fs::symlink(&outside, part.join("out")).unwrap();
+    std::os::unix::fs::symlink(outside.join("there.toml"), part.join("there.toml")).unwrap();
+    std::os::unix::fs::symlink(outside.join("gone.toml"), part.join("gone.toml")).unwrap();
+    part
+}
+
+/// The server obeys only the page opened with its URL, and writes only in its folder. Refused,
+/// with nothing anywhere changed: a request without the token, with a wrong token of the right
+/// length, a cross-site "simple" request (text/plain, another site's Origin), the right token
+/// sent by another site's page, the right token under another Host (DNS rebinding; the page
+/// too), and saving, meshing or slicing to names outside the folder — absolute, `../`, through
+/// a link to a folder or to a file outside, the folder itself. No answer lets another site read
+/// it (no Access-Control-Allow-Origin). The page's own requests are served.
+#[test]
+fn the_server_obeys_only_its_page_and_writes_only_in_its_folder() {
+    let d = tempdir();
+    let root = d.path().canonicalize().unwrap();
+    let part = part_beside_outside(&root);
+    let server = Server::start("part.toml", &part);
+    let host = format!("127.0.0.1:{}", server.port);
+    let own = format!("http://{host}");
+    let wrong = "0".repeat(server.token.len());
+    assert_ne!(wrong, server.token);
+    let h = |pairs: &[(&str, &str)]| -> Headers {
+        pairs
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect()
+    };
+    let token = format!("token {}", server.token);
+    let bad_token = format!("token {wrong}");
+    let evil_host = format!("evil.example:{}", server.port);
+    let outside_abs = root.join("outside/x.toml").display().to_string();
+    let save = |path: &str| format!(r#"{{"settings": {{"type": "gyroid"}}, "path": "{path}"}}"#);
+    let settings =
+        r#"{"type": "gyroid", "density": 0.3, "cells": 1, "cell-size": 4, "resolution": 12}"#;
+    let job = |output: &str| format!(r#"{{"settings": {settings}, "output": "{output}"}}"#);
+    let before = snapshot(&root);
+
+    let json = "application/json";
+    let cases: Vec<(&str, &str, Headers, String, u16)> = vec![
+        // No token, a wrong one: nothing but the page's files.
+        (
+            "GET",
+            "/api/part",
+            h(&[("Host", &host)]),
+            String::new(),
+            401,
+        ),
+        ("GET", "/api/job", h(&[("Host", &host)]), String::new(), 401),
+        (
+            "POST",
+            "/api/save",
+            h(&[("Host", &host), ("Content-Type", json)]),
+            save("saved.toml"),
+            401,
+        ),
+        (
+            "GET",
+            "/api/part",
+            h(&[("Host", &host), ("Authorization", &bad_token)]),
+            String::new(),
+            401,
+        ),
+        (
+            "POST",
+            "/api/save",
+            h(&[("Host", &host), ("Authorization", &bad_token)]),
+            save("saved.toml"),
+            401,
+        ),
+        (
+            "POST",
+            "/api/mesh",
+            h(&[("Host", &host), ("Authorization", "token")]),
+            job("a.stl"),
+            401,
+        ),
+        // A cross-site simple request: no preflight, no token.
+        (
+            "POST",
+            "/api/save",
+            h(&[
+                ("Host", &host),
+                ("Origin", "http://evil.example"),
+                ("Content-Type", "text/plain"),
+            ]),
+            save(&outside_abs),
+            403,
+        ),
+        // Another site's page holding the token, and a preflight from it.
+        (
+            "POST",
+            "/api/save",
+            h(&[
+                ("Host", &host),
+                ("Origin", "http://evil.example"),
+                ("Authorization", &token),
+            ]),
+            save("saved.toml"),
+            403,
+        ),
+        (
+            "GET",
+            "/api/part",
+            h(&[
+                ("Host", &host),
+                ("Origin", "null"),
+                ("Authorization", &token),
+            ]),
+            String::new(),
+            403,
+        ),
+        (
+            "OPTIONS",
+            "/api/save",
+            h(&[
+                ("Host", &host),
+                ("Origin", "http://evil.example"),
+                ("Access-Control-Request-Method", "POST"),
+            ]),
+            String::new(),
+            403,
+        ),
+        // DNS rebinding: the right token, another name.
+        (
+            "GET",
+            "/api/part",
+            h(&[("Host", &evil_host), ("Authorization", &token)]),
+            String::new(),
+            403,
+        ),
+        ("GET", "/", h(&[("Host", &evil_host)]), String::new(), 403),
+        (
+            "GET",
+            "/view.js",
+            h(&[("Host", "evil.example")]),
+            String::new(),
+            403,
+        ),
+        ("GET", "/", h(&[]), String::new(), 403),
+        (
+            "POST",
+            "/api/save",
+            h(&[("Host", &evil_host), ("Authorization", &token)]),
+            save("saved.toml"),
+            403,
+        ),
+    ];
+    for (method, path, headers, body, want) in &cases {
+        let a = server.send(method, path, headers, body);
+        assert_eq!(a.status, *want, "{method} {path} {headers:?}: {}", a.body);
+        assert!(!a.head.contains("access-control-allow"), "{}", a.head);
+        assert_eq!(snapshot(&root), before, "{method} {path} {headers:?} wrote");
+    }
+
+    // With the token, names leading out of the folder.
+    let outside_stl = root.join("outside/x.stl").display().to_string();
+    let outside_cli = root.join("outside/x.cli").display().to_string();
+    let out_of_folder: Vec<(&str, String)> = vec![
+        ("/api/save", save(&outside_abs)),
+        ("/api/save", save("../x.toml")),
+        ("/api/save", save("sub/../../x.toml")),
+        ("/api/save", save("out/x.toml")),
+        ("/api/save", save("there.toml")),
+        ("/api/save", save("gone.toml")),
+        ("/api/mesh", job(&outside_stl)),
+        ("/api/mesh", job("../x.stl")),
+        ("/api/mesh", job("out/x.stl")),
+        ("/api/slice", job(&outside_cli)),
+        ("/api/slice", job("../x.cli")),
+        ("/api/slice", job("out/x.cli")),
+        ("/api/slice", job("out/")),
+        ("/api/slice", job(".")),
+        ("/api/slice", job("./")),
+    ];
+    for (path, body) in &out_of_folder {
+        let (status, text) = server.ask("POST", path, body);
+        assert_eq!(status, 403, "{path} {body}: {text}");
+        assert!(text.contains("outside the folder"), "{text}");
+        assert_eq!(snapshot(&root), before, "{path} {body} wrote");
+    }
+    let (_, job_now) = server.json("GET", "/api/job", "");
+    assert_eq!(job_now["state"], "", "a job started: {job_now}");
+
+    // The page's own requests: its files, its part (from its own origin too), a save inside.
+    for (path, headers) in [
+        ("/", h(&[("Host", &format!("localhost:{}", server.port))])),
+        (
+            "/view.js",
+            h(&[("Host", &format!("[::1]:{}", server.port))]),
+        ),
+    ] {
+        let a = server.send("GET", path, &headers, "");
+        assert_eq!(a.status, 200, "{path}");
+        assert!(a.head.contains("content-security-policy"), "{}", a.head);
+    }
+    let a = server.send(
+        "GET",
+        "/api/part",
+        &h(&[("Host", &host), ("Origin", &own), ("Authorization", &token)]),
+        "",
+    );
+    assert_eq!(a.status, 200, "{}", a.body);
+    let p: serde_json::Value = serde_json::from_str(&a.body).unwrap();
+    assert_eq!(p["folder"], part.display().to_string());
+    assert_eq!(p["save"], part.join("part.toml").display().to_string());
+    let (status, v) = server.json("POST", "/api/save", &save("sub/../saved.toml"));
+    assert_eq!(status, 200, "{v}");
+    assert_eq!(v["saved"], part.join("saved.toml").display().to_string());
+    let text = std::fs::read_to_string(part.join("saved.toml")).unwrap();
+    assert!(text.contains("type = \"gyroid\""), "{text}");
+    // Only that file is new.
+    let mut after = snapshot(&root);
+    after.remove(&part.join("saved.toml"));
+    assert_eq!(after, before);
+}
+
+/// Clients that send half a request, or nothing, do not hold the server: the page's requests
+/// are answered at once beside them.
+#[test]
+fn slow_clients_do_not_hold_the_server() {
+    let d = tempdir();
+    let root = d.path().canonicalize().unwrap();
+    let part = part_beside_outside(&root);
+    let server = Server::start("part.toml", &part);
+    let host = format!("127.0.0.1:{}", server.port);
+    let open = |bytes: &str| {
+        let mut s = TcpStream::connect(("127.0.0.1", server.port)).unwrap();
+        s.write_all(bytes.as_bytes()).unwrap();
+        s
+    };
+    let _held = [
+        open(""),
+        open("GET /api/part HTT"),
+        open(&format!("GET /api/part HTTP/1.1\r\nHost: {host}\r\n")),
+        open(&format!(
+            "POST /api/scene HTTP/1.1\r\nHost: {host}\r\nAuthorization: token {}\r\n\
+             Content-Length: 1000\r\n\r\n{{\"settings\": ",
+            server.token
+        )),
+        open(&format!(
+            "POST /api/save HTTP/1.1\r\nHost: {host}\r\nAuthorization: token {}\r\n\
+             Content-Length: 100\r\n\r\n",
+            server.token
+        )),
+    ];
+    for _ in 0..3 {
+        let t = Instant::now();
+        let (status, _) = server.ask("GET", "/api/part", "");
+        assert_eq!(status, 200);
+        let (status, v) = server.json(
+            "POST",
+            "/api/scene",
+            r#"{"settings": {"type": "d", "cells": 1}}"#,
+        );
+        assert_eq!(status, 200, "{v}");
+        let (status, page) = server.ask("GET", "/", "");
+        assert_eq!(status, 200);
+        assert!(page.contains("<canvas"));
+        let took = t.elapsed();
+        assert!(took < Duration::from_secs(3), "the page waited {took:?}");
+    }
+    // A refusal needs no body: a client that sends a head and stalls is answered at once.
+    let mut s = open(&format!(
+        "POST /api/save HTTP/1.1\r\nHost: {host}\r\nContent-Length: 100\r\n\r\n"
+    ));
+    s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+    let mut answer = String::new();
+    let _ = s.read_to_string(&mut answer);
+    assert!(answer.starts_with("HTTP/1.1 401"), "{answer:?}");
+}
+
+/// With `--out-dir`, the page writes there (names relative to it) and nowhere else, its part
+/// file's folder included; the default part file it saves is there too.
+#[test]
+fn out_dir_is_where_the_page_writes() {
+    let d = tempdir();
+    let root = d.path().canonicalize().unwrap();
+    let part = part_beside_outside(&root);
+    let server = Server::start_with(
+        &["view", "part/part.toml", "--out-dir", "runs/today"],
+        &root,
+    );
+    let runs = root.join("runs/today");
+    assert!(runs.is_dir());
+    let (status, p) = server.json("GET", "/api/part", "");
+    assert_eq!(status, 200, "{p}");
+    assert_eq!(p["folder"], runs.display().to_string());
+    assert_eq!(p["save"], runs.join("part.toml").display().to_string());
+    let before = snapshot(&part);
+    let body = |path: &str| format!(r#"{{"settings": {{"type": "d"}}, "path": "{path}"}}"#);
+    let in_part = part.join("part.toml").display().to_string();
+    for name in [in_part.as_str(), "../../part/x.toml"] {
+        let (status, v) = server.json("POST", "/api/save", &body(name));
+        assert_eq!(status, 403, "{name}: {v}");
+    }
+    assert_eq!(snapshot(&part), before);
+    let (status, v) = server.json("POST", "/api/save", r#"{"settings": {"type": "d"}}"#);
+    assert_eq!(status, 200, "{v}");
+    let (status, v) = server.json("POST", "/api/save", &body("d.toml"));
+    assert_eq!(status, 200, "{v}");
+    assert!(runs.join("part.toml").is_file() && runs.join("d.toml").is_file());
+    assert_eq!(snapshot(&part), before);
+}
+
+/// Random requests — methods, paths, headers (hosts, origins, tokens, lengths, encodings) and
+/// bodies (JSON settings with names in and out of the folder, garbage) — for a few seconds,
+/// from a fixed seed: the server answers each (never a 500), keeps serving, and nothing outside
+/// its folder changes.
+#[test]
+fn random_requests_neither_stop_the_server_nor_write_outside() {
+    let d = tempdir();
+    let root = d.path().canonicalize().unwrap();
+    let part = part_beside_outside(&root);
+    let mut server = Server::start("part.toml", &part);
+    let outside = root.join("outside");
+    let watched = |root: &Path| {
+        let mut s = snapshot(root);
+        s.retain(|p, _| !p.starts_with(&part) || p.parent() == Some(&part) && p.is_symlink());
+        s
+    };
+    let before = watched(&root);
+    let port = server.port;
+    let mut rng = Rng(0x1a77_0c5e);
+    let pick = |rng: &mut Rng, xs: &[String]| xs[rng.below(xs.len() as u64) as usize].clone();
+    let s = |xs: &[&str]| xs.iter().map(|x| x.to_string()).collect::<Vec<String>>();
+    let methods = s(&["PUT", "DELETE", "OPTIONS", "HEAD", "get", "BREW"]);
+    let routes = s(&[
+        "/api/save",
+        "/api/save",
+        "/api/mesh",
+        "/api/slice",
+        "/api/scene",
+        "/api/part",
+        "/api/job",
+        "/",
+    ]);
+    let paths = s(&[
+        "/view.js",
+        "/trace.glsl",
+        "/api/",
+        "/api/save/..",
+        "/API/SAVE",
+        "//api/save",
+        "/api/save?x=1",
+        "/%2e%2e/api/save",
+        "/api/../api/save",
+        "*",
+        "http://evil.example/api/save",
+    ]);
+    let outside_names = [
+        outside.join("x.toml").display().to_string(),
+        outside.join("x.stl").display().to_string(),
+        outside.join("l.cli").display().to_string(),
+        "/tmp/../".to_string() + &outside.join("y.toml").display().to_string(),
+    ];
+    let mut names = s(&[
+        "a.toml",
+        "b.stl",
+        "c.cli",
+        "layers/",
+        "sub/e.toml",
+        "sub/../f.toml",
+        "../x.toml",
+        "../outside/x.stl",
+        "out/x.toml",
+        "out/",
+        "there.toml",
+        "gone.toml",
+        ".",
+        "./",
+        "",
+        "a\u{0}b.toml",
+        "üñí.toml",
+        "sub",
+        "x.xyz",
+        "part.toml",
+        "//",
+        "~/x.toml",
+    ]);
+    names.extend(outside_names);
+    names.push("n".repeat(300) + ".toml");
+    let hosts = vec![
+        format!("127.0.0.1:{port}"),
+        format!("127.0.0.1:{port}"),
+        format!("127.0.0.1:{port}"),
+        format!("localhost:{port}"),
+        format!("evil.example:{port}"),
+        "127.0.0.1".into(),
+        String::new(),
+    ];
+    let origins = vec![
+        String::new(),
+        String::new(),
+        String::new(),
+        format!("http://127.0.0.1:{port}"),
+        "http://evil.example".into(),
+        "null".into(),
+    ];
+    let good = format!("token {}", server.token);
+    let auths = vec![
+        good.clone(),
+        good.clone(),
+        good.clone(),
+        good.clone(),
+        String::new(),
+        format!("token {}", "f".repeat(server.token.len())),
+        format!("Bearer {}", server.token),
+        "token".into(),
+    ];
+    let values = s(&[
+        "0.3",
+        "0.2",
+        "1",
+        "-1",
+        "0",
+        "1e308",
+        "\"x\"",
+        "null",
+        "true",
+        "[1, 2]",
+        "[2, 1, 1]",
+        "{}",
+        "\"gyroid\"",
+        "\"d\"",
+        "\"net\"",
+        "\"sheet\"",
+        "4",
+        "12",
+    ]);
+    let keys = s(&[
+        "type",
+        "structure",
+        "density",
+        "cells",
+        "cell-size",
+        "resolution",
+        "command",
+        "bogus",
+        "radius",
+        "input",
+        "size",
+        "origin",
+    ]);
+    let settings = |rng: &mut Rng| -> String {
+        let mut kv = vec![
+            r#""cells": 1"#.to_string(),
+            r#""cell-size": 4"#.to_string(),
+            r#""resolution": 12"#.to_string(),
+        ];
+        for _ in 0..rng.below(4) {
+            let k = pick(rng, &keys);
+            let v = if k == "input" || k == "command" {
+                quoted(&pick(rng, &names))
+            } else {
+                pick(rng, &values)
+            };
+            kv.push(format!("{}: {v}", quoted(&k)));
+        }
+        format!("{{{}}}", kv.join(", "))
+    };
+    let deadline = Instant::now() + Duration::from_secs(3);
+    let mut sent = 0;
+    let mut answered: BTreeMap<u16, usize> = BTreeMap::new();
+    while Instant::now() < deadline && sent < 1500 {
+        sent += 1;
+        let method = match rng.below(10) {
+            0..=4 => "POST".to_string(),
+            5..=7 => "GET".to_string(),
+            _ => pick(&mut rng, &methods),
+        };
+        let from = if rng.below(5) > 0 { &routes } else { &paths };
+        let path = pick(&mut rng, from);
+        let body = match rng.below(16) {
+            0 => String::new(),
+            1 => {
+                let n = rng.below(64) as usize;
+                (0..n).map(|_| (32 + rng.below(95) as u8) as char).collect()
+            }
+            2 => "[".repeat(rng.below(3000) as usize),
+            _ => {
+                let mut fields = vec![format!(r#""settings": {}"#, settings(&mut rng))];
+                for key in ["path", "output"] {
+                    if rng.below(3) > 0 {
+                        fields.push(format!("{key:?}: {}", quoted(&pick(&mut rng, &names))));
+                    }
+                }
+                if rng.below(2) == 0 {
+                    fields.push(format!(
+                        r#""layer": {}"#,
+                        pick(&mut rng, &s(&["0.5", "1", "-1", "0", "\"x\"", "null"]))
+                    ));
+                }
+                format!("{{{}}}", fields.join(", "))
+            }
+        };
+        let mut head = format!("{method} {path} HTTP/1.1\r\n");
+        let mut header = |k: &str, v: &str| {
+            if !v.is_empty() {
+                head.push_str(&format!("{k}: {v}\r\n"));
+            }
+        };
+        // Most requests are the page's own, to reach past the checks into the API.
+        if rng.below(4) > 0 {
+            header("Host", &hosts[0]);
+            header("Authorization", &good);
+        } else {
+            header("Host", &pick(&mut rng, &hosts));
+            header("Origin", &pick(&mut rng, &origins));
+            header("Authorization", &pick(&mut rng, &auths));
+        }
+        header(
+            "Content-Type",
+            if rng.below(4) == 0 {
+                "text/plain"
+            } else {
+                "application/json"
+            },
+        );
+        let length = match rng.below(30) {
+            0 => String::new(),
+            1 => (body.len() + 1 + rng.below(50) as usize).to_string(),
+            2 => body
+                .len()
+                .saturating_sub(1 + rng.below(5) as usize)
+                .to_string(),
+            3 => "99999999999999999999".into(),
+            4 => "-1".into(),
+            5 => format!("{0}\r\nContent-Length: {0}", body.len()),
+            _ => body.len().to_string(),
+        };
+        header("Content-Length", &length);
+        if rng.below(20) == 0 {
+            header("Transfer-Encoding", "chunked");
+        }
+        if rng.below(10) == 0 {
+            header("Expect", "100-continue");
+        }
+        if rng.below(30) == 0 {
+            head.push_str("Bad Header Line\r\n");
+        }
+        head.push_str("Connection: close\r\n\r\n");
+        let mut bytes = head.into_bytes();
+        bytes.extend_from_slice(body.as_bytes());
+        if rng.below(25) == 0 {
+            // Bytes that are not text.
+            let at = rng.below(bytes.len() as u64) as usize;
+            bytes[at] = 0xff;
+        }
+        if rng.below(25) == 0 {
+            let at = rng.below(bytes.len() as u64) as usize;
+            bytes.truncate(at);
+        }
+        let mut c = TcpStream::connect(("127.0.0.1", port)).unwrap();
+        c.set_read_timeout(Some(Duration::from_secs(15))).unwrap();
+        let _ = c.write_all(&bytes);
+        // The request ends here: a length that promises more meets the end of the stream.
+        let _ = c.shutdown(Shutdown::Write);
+        let mut answer = Vec::new();
+        let _ = c.read_to_end(&mut answer);
+        let text = String::from_utf8_lossy(&answer);
+        // The final answer, past a "100 Continue".
+        let last = text.rsplit("HTTP/1.1 ").next().unwrap_or_default();
+        let status: u16 = last
+            .split(' ')
+            .next()
+            .and_then(|c| c.parse().ok())
+            .unwrap_or(0);
+        // A request that ends inside its head may go unanswered; any answer is one of ours.
+        assert!(
+            status != 500 && (status == 0 || (100..600).contains(&status)),
+            "{text}"
+        );
+        if status == 0 {
+            assert!(answer.is_empty(), "{text}");
+        }
+        *answered.entry(status).or_default() += 1;
+        assert!(
+            server_alive(&mut server),
+            "the server stopped after {bytes:?}"
+        );
+    }
+    eprintln!("{sent} random requests: answers by status {answered:?}");
+    assert!(answered.get(&200).copied().unwrap_or(0) > 0, "{answered:?}");
+    assert!(
+        answered.keys().filter(|&&s| s >= 400).count() >= 5,
+        "{answered:?}"
+    );
+    // A job started at random ends before the folder is looked at.
+    let start = Instant::now();
+    loop {
+        let (status, j) = server.json("GET", "/api/job", "");
+        assert_eq!(status, 200);
+        if j["state"] != "running" {
+            break;
+        }
+        assert!(start.elapsed() < Duration::from_secs(120), "{j}");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let (status, _) = server.ask("GET", "/api/part", "");
+    assert_eq!(status, 200);
+    assert_eq!(
+        watched(&root),
+        before,
+        "something outside the folder changed"
+    );
+}
+
+fn server_alive(server: &mut Server) -> bool {
+    server.child.try_wait().unwrap().is_none()
+}
+
+/// `s` as a JSON string.
+fn quoted(s: &str) -> String {
+    serde_json::to_string(s).unwrap()
 }

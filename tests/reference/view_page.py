@@ -2,14 +2,15 @@
 would, and writes what it saw for the Rust test to compare with `latvox render`.
 
     python3 view_page.py URL OUT_DIR --width W --height H --azimuth A --elevation E
-        [--section AXIS=MM] [--edit KEY=VALUE] [--save FILE.toml] [--fps N] [--shot FILE.png]
+        [--section AXIS=MM] [--edit KEY=VALUE] [--save FILE.toml] [--mesh FILE] [--slice FILE]
+        [--layer MM] [--fps N] [--shot FILE.png]
 
 Writes OUT_DIR/first.mask and, after the edit, OUT_DIR/edited.mask (one '0'/'1' per pixel, top
 row first: where the page's rays met the part), OUT_DIR/first.rgb (the first frame's colours,
-8-bit RGB, top row first), OUT_DIR/page.png (a screenshot), and prints
-one JSON object: frames drawn, scene versions, whether the edit re-rendered, the saved file,
-the fps, any error the page showed. Exit 3 when no browser can be started (the test then says
-so and skips), 1 on any other failure.
+8-bit RGB, top row first), OUT_DIR/page.png (a screenshot), and prints one JSON object: frames
+drawn, scene versions, whether the edit re-rendered, the saved file, the meshing and slicing
+jobs as the page saw them end, the fps, any error the page showed. Exit 3 when no browser can
+be started (the test then says so and skips), 1 on any other failure.
 """
 
 import argparse
@@ -39,6 +40,9 @@ def main():
     ap.add_argument("--section", default=None, help="AXIS=MM: cut there, keep below")
     ap.add_argument("--edit", default=None)
     ap.add_argument("--save", default=None)
+    ap.add_argument("--mesh", default=None, help="mesh the part from the page to this name")
+    ap.add_argument("--slice", default=None, help="slice the part from the page to this name")
+    ap.add_argument("--layer", type=float, default=0.5, help="the slices' layer, mm")
     ap.add_argument("--fps", type=int, default=0)
     ap.add_argument("--shot", default=None, help="a screenshot of the whole page (PNG)")
     ap.add_argument("--gpu", action="store_true", help="use the machine's GPU, not SwiftShader")
@@ -72,7 +76,9 @@ def main():
         page = browser.new_page(viewport={"width": a.width + 320, "height": a.height + 40})
         errors = []
         page.on("pageerror", lambda e: errors.append(str(e)))
-        page.goto(f"{a.url}?width={a.width}&height={a.height}")
+        # The URL latvox printed carries the token in its query: the size joins it.
+        sep = "&" if "?" in a.url else "?"
+        page.goto(f"{a.url}{sep}width={a.width}&height={a.height}")
         page.wait_for_function("window.latvox && (window.latvox.ready || window.latvox.error)",
                                timeout=120_000)
         err = page.evaluate("window.latvox.error")
@@ -124,6 +130,20 @@ def main():
             page.click("#save")
             page.wait_for_function("window.latvox.saved || window.latvox.error", timeout=60_000)
             out["saved"] = page.evaluate("window.latvox.saved")
+
+        # Meshing and slicing as a user asks for them: a name, the button, the job polled to
+        # its end by the page.
+        for what, name, field in (("meshing", a.mesh, "#meshPath"), ("slicing", a.slice, "#slicePath")):
+            if not name:
+                continue
+            page.fill(field, name)
+            if what == "slicing":
+                page.fill("#sliceLayer", str(a.layer))
+            page.click("#mesh" if what == "meshing" else "#slice")
+            page.wait_for_function(
+                f"(window.latvox.job && window.latvox.job.what === '{what}'"
+                " && !window.latvox.busy) || window.latvox.error", timeout=300_000)
+            out[what] = page.evaluate("window.latvox.job")
 
         if a.fps:
             out["fps"] = page.evaluate(f"window.latvox.bench({a.fps})")

@@ -50,7 +50,11 @@ def main():
                                   stdout=subprocess.PIPE, text=True)
         try:
             url = server.stdout.readline().strip()
-            part = json.load(urllib.request.urlopen(url + "api/part", timeout=600))
+            # The printed URL carries the run's token; the API wants it in a header.
+            base, _, token = url.partition("?token=")
+            ask = urllib.request.Request(base + "api/part",
+                                         headers={"Authorization": "token " + token})
+            part = json.load(urllib.request.urlopen(ask, timeout=600))
         finally:
             server.kill()
             server.wait()

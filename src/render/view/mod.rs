@@ -6,27 +6,44 @@
 //! The page never meshes; everything it loads is served from here (no CDN, no build step).
 //!
 //! Routes: `GET /` (the page), `/view.js`, `/trace.glsl`; `GET /api/part` (settings, scene,
-//! choices); `POST /api/scene` (settings → scene), `/api/save`, `/api/mesh`, `/api/slice`;
-//! `GET /api/job`. A bad request gets a 4xx answer with `{"error": "…"}` and the server goes on.
+//! choices, the folder written in); `POST /api/scene` (settings → scene), `/api/save`,
+//! `/api/mesh`, `/api/slice`; `GET /api/job`. A bad request gets a 4xx answer with
+//! `{"error": "…"}` and the server goes on.
+//!
+//! Only the page the user opened is obeyed ([`guard`]): every request must name this server by
+//! its loopback address (no DNS rebinding) and come from no other site's page, every request but
+//! the page's own files must carry the run's token, and what is written stays in one folder.
+//! Requests are read and answered as [`http`] bounds them (time, size, connections).
 
+pub mod guard;
+mod http;
 pub mod scene;
 
 use crate::error::{Error, Result};
+use guard::{Folder, Local, Outside, Token};
+use http::{Head, Response};
 use scene::Scene;
 use serde_json::{json, Value};
 use std::io::{BufRead, BufReader, Read};
+use std::net::TcpListener;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
-use tiny_http::{Header, Method, Request, Response};
 
 const PAGE: &str = include_str!("page/index.html");
 const SCRIPT: &str = include_str!("page/view.js");
 const SHADER: &str = include_str!("page/trace.glsl");
 
-/// The largest request body read, bytes.
-const MAX_BODY: u64 = 1 << 20;
+/// What the page may load and where it may connect: this server only, and no other page may
+/// frame it. The page never evaluates strings, but scripts that drive it (Playwright, in the
+/// browser tests) do: `'unsafe-eval'` lets them see the page as users do, under this policy.
+const POLICY: &str = "default-src 'self'; script-src 'self' 'unsafe-eval'; \
+                      style-src 'self' 'unsafe-inline'; img-src 'self' data:; object-src 'none'; \
+                      base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
+
+/// The commands whose parts the editor meshes (the command a child `latvox` runs).
+const COMMANDS: &[&str] = &["tpms", "strut", "fill"];
 
 /// What the page draws of a part's settings, with every refusal of the part's command.
 pub type SceneOf = Box<dyn Fn(&toml::Table) -> Result<Scene> + Send + Sync>;
@@ -44,7 +61,8 @@ pub struct Hooks {
 
 /// The part being edited.
 pub struct Editor {
-    /// The part file opened (the page saves there unless told another name).
+    /// The part file opened (the page saves there unless told another name, when it lies in
+    /// `folder`).
     pub path: PathBuf,
     /// Its settings, `command` included.
     pub settings: toml::Table,
@@ -54,6 +72,10 @@ pub struct Editor {
     pub exe: PathBuf,
     /// The command line's part handling.
     pub hooks: Hooks,
+    /// The folder the page's part files, meshes and slices are written in.
+    pub folder: Folder,
+    /// The secret every request must carry.
+    pub token: Token,
 }
 
 /// A meshing or slicing run.
@@ -77,136 +99,205 @@ fn bad(status: u16, message: impl Into<String>) -> Answer {
     (status, json!({ "error": message.into() }))
 }
 
-/// Serves `editor` on `server` until the process is stopped.
-pub fn serve(server: tiny_http::Server, editor: Editor) -> Result<()> {
-    let job = Arc::new(Mutex::new(Job::default()));
-    for mut request in server.incoming_requests() {
-        let url = request.url().split('?').next().unwrap_or("").to_string();
-        let method = request.method().clone();
-        let response = match (&method, url.as_str()) {
-            (Method::Get, "/") => text(PAGE, "text/html; charset=utf-8"),
-            (Method::Get, "/view.js") => text(SCRIPT, "text/javascript; charset=utf-8"),
-            (Method::Get, "/trace.glsl") => text(SHADER, "text/plain; charset=utf-8"),
-            (_, path) if path.starts_with("/api/") => {
-                let (status, body) = match read_body(&mut request) {
-                    Ok(body) => api(&editor, &job, &method, path, body),
-                    Err(a) => a,
-                };
-                let mut r = Response::from_string(body.to_string()).with_status_code(status);
-                r.add_header(header("Content-Type", "application/json"));
-                r
-            }
-            _ => Response::from_string("not found").with_status_code(404),
-        };
-        // A client gone before its answer is no reason to stop.
-        let _ = request.respond(response);
+/// A name outside the folder: refused, nothing written.
+fn outside(e: Outside) -> Answer {
+    bad(403, e.0)
+}
+
+/// The server's state: the part, where the page saves by default, the running job.
+struct Server {
+    editor: Editor,
+    local: Local,
+    /// The part file saved when the page names none.
+    save: PathBuf,
+    job: Arc<Mutex<Job>>,
+}
+
+/// Serves `editor` on `listener` until the process is stopped; the listener must be bound to a
+/// loopback address (127.0.0.1), as nothing else is served.
+pub fn serve(listener: TcpListener, editor: Editor) -> Result<()> {
+    let address = listener
+        .local_addr()
+        .map_err(|e| Error::io("127.0.0.1", e))?;
+    if !address.ip().is_loopback() {
+        return Err(Error::invalid(format!(
+            "{address}: the editor listens on the loopback address only"
+        )));
     }
+    let port = address.port();
+    let part = editor
+        .path
+        .canonicalize()
+        .unwrap_or_else(|_| editor.path.clone());
+    let save = if editor.folder.holds(&part) {
+        part
+    } else {
+        let name = part.file_name().unwrap_or("part.toml".as_ref());
+        editor.folder.root().join(name)
+    };
+    let server = Server {
+        editor,
+        local: Local::new(port),
+        save,
+        job: Arc::new(Mutex::new(Job::default())),
+    };
+    http::serve(listener, Arc::new(server));
     Ok(())
 }
 
-fn header(name: &str, value: &str) -> Header {
-    Header::from_bytes(name.as_bytes(), value.as_bytes()).expect("a valid header")
+/// The page's own files: served without the token (they hold no secret, and the page reads the
+/// token from its own address).
+fn public(head: &Head) -> bool {
+    head.method == "GET" && matches!(head.path.as_str(), "/" | "/view.js" | "/trace.glsl")
 }
 
-fn text(body: &str, kind: &str) -> Response<std::io::Cursor<Vec<u8>>> {
-    let mut r = Response::from_string(body);
-    r.add_header(header("Content-Type", kind));
-    r.add_header(header("Cache-Control", "no-store"));
-    r
+impl http::Handler for Server {
+    fn admit(&self, head: &Head) -> Option<Response> {
+        let refuse = |status: u16, message: &str| {
+            Some(if head.path.starts_with("/api/") {
+                Response::error(status, message)
+            } else {
+                Response::new(status, "text/plain; charset=utf-8", message)
+            })
+        };
+        if !self.local.host_ok(head.header("host")) {
+            return refuse(
+                403,
+                "this server answers to 127.0.0.1, localhost and [::1] with its port only",
+            );
+        }
+        if head.count("origin") > 1 || !self.local.origin_ok(head.header("origin")) {
+            return refuse(403, "requests from other sites' pages are refused");
+        }
+        if !public(head) && !self.editor.token.admits(head.header("authorization")) {
+            return refuse(
+                401,
+                "the request lacks the editor's token: open the URL `latvox view` printed, with its ?token=",
+            );
+        }
+        None
+    }
+
+    fn answer(&self, head: &Head, body: &[u8]) -> Response {
+        let page = |text: &str, kind: &'static str| {
+            let mut r = Response::new(200, kind, text);
+            r.headers
+                .push(("Content-Security-Policy", POLICY.to_string()));
+            r
+        };
+        match (head.method.as_str(), head.path.as_str()) {
+            ("GET", "/") => page(PAGE, "text/html; charset=utf-8"),
+            ("GET", "/view.js") => page(SCRIPT, "text/javascript; charset=utf-8"),
+            ("GET", "/trace.glsl") => page(SHADER, "text/plain; charset=utf-8"),
+            (method, path) if path.starts_with("/api/") => {
+                let (status, value) = match json_body(body) {
+                    Ok(body) => self.api(method, path, body),
+                    Err(a) => a,
+                };
+                Response::json(status, &value)
+            }
+            _ => Response::new(404, "text/plain; charset=utf-8", "not found"),
+        }
+    }
 }
 
 /// The request's JSON body (`Null` when empty).
-fn read_body(request: &mut Request) -> std::result::Result<Value, Answer> {
-    if request.body_length().unwrap_or(0) as u64 > MAX_BODY {
-        return Err(bad(413, "the request is larger than 1 MB"));
-    }
-    let mut raw = Vec::new();
-    request
-        .as_reader()
-        .take(MAX_BODY + 1)
-        .read_to_end(&mut raw)
-        .map_err(|e| bad(400, format!("the request could not be read: {e}")))?;
-    if raw.len() as u64 > MAX_BODY {
-        return Err(bad(413, "the request is larger than 1 MB"));
-    }
+fn json_body(raw: &[u8]) -> std::result::Result<Value, Answer> {
     if raw.iter().all(u8::is_ascii_whitespace) {
         return Ok(Value::Null);
     }
-    serde_json::from_slice(&raw).map_err(|e| bad(400, format!("the request is not JSON: {e}")))
+    serde_json::from_slice(raw).map_err(|e| bad(400, format!("the request is not JSON: {e}")))
 }
 
-fn api(editor: &Editor, job: &Arc<Mutex<Job>>, method: &Method, path: &str, body: Value) -> Answer {
-    match (method, path) {
-        (Method::Get, "/api/part") => match scene_of(editor, &editor.settings) {
-            Ok(scene) => (
-                200,
-                json!({
-                    "path": editor.path.display().to_string(),
-                    "settings": editor.settings,
-                    "choices": editor.choices,
-                    "scene": scene,
-                }),
-            ),
-            Err(e) => bad(422, e.to_string()),
-        },
-        (Method::Post, "/api/scene") => {
-            match settings(editor, &body).and_then(|s| scene_of(editor, &s)) {
-                Ok(scene) => (200, json!({ "scene": scene })),
+impl Server {
+    fn api(&self, method: &str, path: &str, body: Value) -> Answer {
+        let editor = &self.editor;
+        match (method, path) {
+            ("GET", "/api/part") => match scene_of(editor, &editor.settings) {
+                Ok(scene) => (
+                    200,
+                    json!({
+                        "path": editor.path.display().to_string(),
+                        "folder": editor.folder.root().display().to_string(),
+                        "save": self.save.display().to_string(),
+                        "settings": editor.settings,
+                        "choices": editor.choices,
+                        "scene": scene,
+                    }),
+                ),
                 Err(e) => bad(422, e.to_string()),
-            }
-        }
-        (Method::Post, "/api/save") => {
-            let run = || -> Result<String> {
-                let s = settings(editor, &body)?;
-                let to = output(&body, "path")?.unwrap_or_else(|| editor.path.clone());
-                if !to
-                    .extension()
-                    .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
-                {
-                    return Err(Error::invalid(format!(
-                        "{}: part files are saved as .toml",
-                        to.display()
-                    )));
+            },
+            ("POST", "/api/scene") => {
+                match settings(editor, &body).and_then(|s| scene_of(editor, &s)) {
+                    Ok(scene) => (200, json!({ "scene": scene })),
+                    Err(e) => bad(422, e.to_string()),
                 }
-                // Only a part the command accepts is saved.
-                (editor.hooks.scene)(&s)?;
-                (editor.hooks.save)(&to, &s)?;
-                Ok(to.display().to_string())
-            };
-            match run() {
-                Ok(saved) => (200, json!({ "saved": saved })),
-                Err(e) => bad(422, e.to_string()),
             }
-        }
-        (Method::Post, "/api/mesh") | (Method::Post, "/api/slice") => {
-            match start(editor, job, path == "/api/mesh", &body) {
-                Ok(()) => (202, json!({ "started": true })),
-                Err((status, e)) => bad(status, e.to_string()),
+            ("POST", "/api/save") => self.save(&body),
+            ("POST", "/api/mesh") | ("POST", "/api/slice") => {
+                match start(editor, &self.job, path == "/api/mesh", &body) {
+                    Ok(()) => (202, json!({ "started": true })),
+                    Err(a) => a,
+                }
             }
-        }
-        (Method::Get, "/api/job") => {
-            let j = job.lock().unwrap_or_else(|e| e.into_inner());
-            let seconds = match (j.state, j.started) {
-                ("running", Some(s)) => s.elapsed().as_secs_f64(),
-                _ => j.seconds,
-            };
+            ("GET", "/api/job") => {
+                let j = self.job.lock().unwrap_or_else(|e| e.into_inner());
+                let seconds = match (j.state, j.started) {
+                    ("running", Some(s)) => s.elapsed().as_secs_f64(),
+                    _ => j.seconds,
+                };
+                (
+                    200,
+                    json!({
+                        "state": j.state,
+                        "what": j.what,
+                        "output": j.output,
+                        "stage": j.stage,
+                        "message": j.message,
+                        "report": j.report,
+                        "seconds": seconds,
+                    }),
+                )
+            }
             (
-                200,
-                json!({
-                    "state": j.state,
-                    "what": j.what,
-                    "output": j.output,
-                    "stage": j.stage,
-                    "message": j.message,
-                    "report": j.report,
-                    "seconds": seconds,
-                }),
-            )
+                _,
+                "/api/part" | "/api/scene" | "/api/save" | "/api/mesh" | "/api/slice" | "/api/job",
+            ) => bad(405, format!("{path} does not take {method}")),
+            _ => bad(404, format!("{path}: no such request")),
         }
-        (_, "/api/part" | "/api/scene" | "/api/save" | "/api/mesh" | "/api/slice" | "/api/job") => {
-            bad(405, format!("{path} does not take {method}"))
+    }
+
+    /// Writes the request's settings as a part file, in the folder.
+    fn save(&self, body: &Value) -> Answer {
+        let editor = &self.editor;
+        let to = match output(body, "path") {
+            Ok(Some(name)) => match editor.folder.resolve(&name) {
+                Ok(p) => p,
+                Err(e) => return outside(e),
+            },
+            Ok(None) => self.save.clone(),
+            Err(e) => return bad(422, e.to_string()),
+        };
+        let run = || -> Result<String> {
+            let s = settings(editor, body)?;
+            if !to
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+            {
+                return Err(Error::invalid(format!(
+                    "{}: part files are saved as .toml",
+                    to.display()
+                )));
+            }
+            // Only a part the command accepts is saved.
+            (editor.hooks.scene)(&s)?;
+            (editor.hooks.save)(&to, &s)?;
+            Ok(to.display().to_string())
+        };
+        match run() {
+            Ok(saved) => (200, json!({ "saved": saved })),
+            Err(e) => bad(422, e.to_string()),
         }
-        _ => bad(404, format!("{path}: no such request")),
     }
 }
 
@@ -237,31 +328,53 @@ fn settings(editor: &Editor, body: &Value) -> Result<toml::Table> {
 }
 
 /// An output name a request gives under `key`, if any.
-fn output(body: &Value, key: &str) -> Result<Option<PathBuf>> {
+fn output(body: &Value, key: &str) -> Result<Option<String>> {
     match body.get(key) {
         None | Some(Value::Null) => Ok(None),
-        Some(Value::String(s)) if !s.trim().is_empty() => Ok(Some(PathBuf::from(s.trim()))),
+        // Control characters (a NUL above all) name no file a user means, and a program's
+        // arguments cannot hold a NUL.
+        Some(Value::String(s)) if s.chars().any(char::is_control) => Err(Error::invalid(format!(
+            "'{key}' holds control characters: not a file name"
+        ))),
+        Some(Value::String(s)) if !s.trim().is_empty() => Ok(Some(s.trim().to_string())),
         Some(_) => Err(Error::invalid(format!("'{key}' must be a file name"))),
     }
 }
 
-/// Starts meshing (`mesh`) or slicing the part of the request's settings in a child process.
+/// Starts meshing (`mesh`) or slicing the part of the request's settings in a child process
+/// that writes inside the folder.
 fn start(
     editor: &Editor,
     job: &Arc<Mutex<Job>>,
     mesh: bool,
     body: &Value,
-) -> std::result::Result<(), (u16, Error)> {
-    let invalid = |e: Error| (422, e);
+) -> std::result::Result<(), Answer> {
+    let invalid = |e: Error| bad(422, e.to_string());
     let s = settings(editor, body).map_err(invalid)?;
-    let out = output(body, "output")
+    let name = output(body, "output")
         .map_err(invalid)?
-        .ok_or_else(|| invalid(Error::invalid("the request names no output")))?;
+        .ok_or_else(|| bad(422, "the request names no output"))?;
+    let mut out = editor
+        .folder
+        .resolve(&name)
+        .map_err(outside)?
+        .display()
+        .to_string();
+    // A name ending in `/` asks `slice` for a folder of layers.
+    if name.ends_with('/') {
+        out.push('/');
+    }
     (editor.hooks.scene)(&s).map_err(invalid)?;
-    let dir = tempfile::tempdir().map_err(|e| (500, Error::io(std::env::temp_dir(), e)))?;
-    let part = dir.path().join("part.toml");
-    (editor.hooks.save)(&part, &s).map_err(|e| (500, e))?;
+    // The program run is always latvox, and its subcommand one that makes a part: never what a
+    // request or a part file names.
     let command = s.get("command").and_then(toml::Value::as_str).unwrap_or("");
+    if !COMMANDS.contains(&command) {
+        return Err(bad(422, format!("'{command}' parts are not meshed here")));
+    }
+    let dir = tempfile::tempdir()
+        .map_err(|e| bad(500, Error::io(std::env::temp_dir(), e).to_string()))?;
+    let part = dir.path().join("part.toml");
+    (editor.hooks.save)(&part, &s).map_err(|e| bad(500, e.to_string()))?;
     let mut args: Vec<String> = if mesh {
         vec![command.into(), "--part".into(), part.display().to_string()]
     } else {
@@ -269,7 +382,7 @@ fn start(
     };
     // The meshing commands write their report to a file, `slice` prints it.
     let report = dir.path().join("report.json");
-    args.extend(["-o".into(), out.display().to_string()]);
+    args.extend(["-o".into(), out.clone()]);
     if mesh {
         args.extend(["--report".into(), report.display().to_string()]);
     } else {
@@ -280,19 +393,19 @@ fn start(
             let h = layer
                 .as_f64()
                 .filter(|h| *h > 0.0)
-                .ok_or_else(|| invalid(Error::invalid("'layer' must be a thickness in mm")))?;
+                .ok_or_else(|| bad(422, "'layer' must be a thickness in mm"))?;
             args.extend(["--layer".into(), h.to_string()]);
         }
     }
     {
         let mut j = job.lock().unwrap_or_else(|e| e.into_inner());
         if j.state == "running" {
-            return Err((409, Error::invalid(format!("{} is still running", j.what))));
+            return Err(bad(409, format!("{} is still running", j.what)));
         }
         *j = Job {
             state: "running",
             what: if mesh { "meshing" } else { "slicing" }.into(),
-            output: out.display().to_string(),
+            output: out,
             stage: "starting".into(),
             started: Some(Instant::now()),
             ..Job::default()
@@ -301,13 +414,14 @@ fn start(
     let mut child = Command::new(&editor.exe)
         .args(&args)
         .env("LATVOX_PROGRESS", "lines")
+        .current_dir(editor.folder.root())
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .map_err(|e| {
             job.lock().unwrap_or_else(|e| e.into_inner()).state = "failed";
-            (500, Error::io(&editor.exe, e))
+            bad(500, Error::io(&editor.exe, e).to_string())
         })?;
     let job = Arc::clone(job);
     std::thread::spawn(move || {

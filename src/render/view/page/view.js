@@ -5,6 +5,8 @@
 
 const FOV = 30; // degrees, vertical: as `latvox render`
 const query = new URLSearchParams(location.search);
+// The run's secret, from the URL `latvox view` printed: every request to the server carries it.
+const TOKEN = query.get('token') || '';
 const canvas = document.getElementById('view');
 const gl = canvas.getContext('webgl2', { preserveDrawingBuffer: true, antialias: false });
 const $ = (id) => document.getElementById(id);
@@ -325,9 +327,11 @@ state.setCamera = function (c) {
 // ---------------------------------------------------------------------------------- server
 
 async function call(method, path, body) {
+  const headers = { Authorization: `token ${TOKEN}` };
+  if (body) headers['Content-Type'] = 'application/json';
   const r = await fetch(path, {
     method,
-    headers: body ? { 'Content-Type': 'application/json' } : {},
+    headers,
     body: body ? JSON.stringify(body) : undefined,
   });
   const answer = await r.json();
@@ -577,11 +581,16 @@ async function main() {
     return;
   }
   try {
+    if (!TOKEN) {
+      status('This address lacks the editor\'s token: open the URL latvox view printed (…/?token=…).', true);
+      return;
+    }
     await setupGl();
     state.part = await call('GET', '/api/part');
     state.settings = JSON.parse(JSON.stringify(state.part.settings));
     $('path').textContent = state.part.path;
-    $('savePath').value = state.part.path;
+    $('folder').textContent = `Files are written in ${state.part.folder} (names relative to it).`;
+    $('savePath').value = state.part.save;
     buildSettings();
     wire();
     useScene(state.part.scene);
