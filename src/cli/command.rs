@@ -10,6 +10,12 @@ use clap::{ArgMatches, FromArgMatches};
 use latvox::batch::Task;
 use latvox::{Error, Result};
 
+/// Arguments as a batch job.
+pub(crate) type JobOf = fn(&ArgMatches) -> Result<Box<dyn Task>>;
+
+/// Arguments as the part they describe, to trace.
+pub(crate) type TraceOf = fn(&ArgMatches) -> Result<Part>;
+
 /// A subcommand.
 pub(crate) struct Command {
     /// Its name on the command line, in part files and in job files.
@@ -27,9 +33,9 @@ pub(crate) struct Command {
     /// The settings that define its part, where it makes one that part files hold.
     pub part: Option<PartKeys>,
     /// Its arguments as a batch job, where it can be one.
-    pub job: Option<fn(&ArgMatches) -> Result<Box<dyn Task>>>,
+    pub job: Option<JobOf>,
     /// Its part as an implicit solid to trace (render, slice, view), where it has one.
-    pub trace: Option<fn(&ArgMatches) -> Result<Part>>,
+    pub trace: Option<TraceOf>,
     /// The choices the browser editor offers for its part: option name → values.
     pub choices: Option<fn() -> serde_json::Value>,
 }
