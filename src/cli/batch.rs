@@ -20,10 +20,8 @@ use latvox::{Error, Result};
 use std::path::{Path, PathBuf};
 
 pub(crate) const EXAMPLES: &str = "\
-Job file (paths relative to it; keys are the subcommand's long options):
-  [defaults]
-  resolution = 32
-
+Job file (paths relative to it; keys are the subcommand's long options; a [defaults] table
+holds options every job of the file takes):
   [[job]]
   command = \"tpms\"
   output = \"out/g-030.stl\"       # the report goes to out/g-030.json
@@ -32,6 +30,7 @@ Job file (paths relative to it; keys are the subcommand's long options):
   density = 0.3
   cells = [4, 4, 2]              # --cells 4,4,2
   cell-size = 5
+  resolution = 32
 
   [[sweep]]                      # every list is an axis: 2 × 3 = 6 jobs
   command = \"tpms\"
@@ -41,7 +40,7 @@ Job file (paths relative to it; keys are the subcommand's long options):
   cells = 3
 
   [[job]]
-  command = \"topo\"               # a density field to a printable part
+  command = \"interpret\"          # a density field to a printable part
   input = \"bracket.npy\"
   output = \"out/bracket.stl\"
   element-size = 2
@@ -61,10 +60,10 @@ Job file (paths relative to it; keys are the subcommand's long options):
   layer = 0.05
   csv = \"out/bracket-layers.csv\"
 
-Jobs run the subcommands that make a part — tpms, strut, fill, fgm, topo and repair — and
-slice, with the options of `latvox tpms`, `latvox strut`, `latvox fill`, `latvox fgm`, `latvox
-topo`, `latvox repair` and `latvox slice` (`input` is the input file; a slice job passes when every loop
-closed).
+Jobs run the subcommands that make a part — tpms, strut, fill, fgm, interpret and repair —
+and slice, with the options of `latvox tpms`, `latvox strut`, `latvox fill`, `latvox fgm`,
+`latvox interpret`, `latvox repair` and `latvox slice` (`input` is the input file; a slice job
+passes when every loop closed).
 
 Examples:
   latvox batch jobs.toml                       # run all jobs, 1 worker per thread

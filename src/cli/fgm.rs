@@ -18,18 +18,21 @@ use std::path::{Path, PathBuf};
 pub(crate) const EXAMPLES: &str = "\
 Examples:
   # A scanned part (x y z per line, normals estimated), its surface hard and its core soft:
-  # Rigid at the skin, Flexible 4 mm in, linear between; a .vdb for simulation and a
-  # coloured mesh to look at
-  latvox fgm --points scan.xyz --voxel 0.2 --feature skin --materials Rigid,Flexible \\
+  # the first material follows the law (none at the skin, all of it 4 mm in), the last takes
+  # the rest: Rigid at the skin, Flexible inside, a smooth step between; a .vdb for simulation
+  # and a coloured mesh to look at
+  latvox fgm --points scan.xyz --voxel 0.2 --feature skin --materials Flexible,Rigid \\
       --law step:0:4 --vdb part.vdb -o part.ply
 
   # The same as PolyJet slices (600 × 300 dpi, 27 µm layers), one material per pixel
-  latvox fgm --points scan.xyz --voxel 0.2 --feature skin --materials Rigid,Flexible \\
-      --law step:0:4 --png-stack slices --palette '#00a0e0,#f0c000'
+  latvox fgm --points scan.xyz --voxel 0.2 --feature skin --materials Flexible,Rigid \\
+      --law step:0:4 --png-stack slices --palette '#f0c000,#00a0e0'
 
-  # Graded from a point (a load) by a square law, three materials, from a mesh
-  latvox fgm --mesh bracket.stl --voxel 0.25 --feature point:10,0,5 --materials A,B,C \\
-      --law power:2 --law step:2:6 --vdb bracket.vdb
+  # Graded from a point (a load), three materials, from a mesh: Tough growing by a square law
+  # away from the point, Hard fading out over 6 mm from it (a table: rows d, fraction, here
+  # 0,1 and 6,0), Soft the rest
+  latvox fgm --mesh bracket.stl --voxel 0.25 --feature point:10,0,5 --materials Tough,Hard,Soft \\
+      --law power:2 --law table:near.csv --vdb bracket.vdb
 
   # The inside told by line scans, as the implicit FGM literature does (clean scans only)
   latvox fgm --points clean.ply --voxel 0.5 --sign scan -o part.ply

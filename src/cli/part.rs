@@ -399,16 +399,25 @@ pub(crate) fn part_of_table(table: &toml::Table, path: &Path) -> Result<Part> {
 }
 
 fn part_from(command: &str, table: &toml::Table, path: &Path) -> Result<Part> {
-    let traced = |c: &&Command| c.trace.is_some();
-    let Some((command, trace)) = find(command)
-        .filter(traced)
-        .and_then(|c| Some((c, c.trace?)))
-    else {
-        return Err(Error::invalid(format!(
-            "{}: a part file needs `command` ({})",
-            path.display(),
-            names_with(|c| c.trace.is_some())
-        )));
+    let (command, trace) = match find(command) {
+        Some(c @ Command { trace: Some(t), .. }) => (c, *t),
+        Some(c) => {
+            return Err(Error::invalid(format!(
+                "{}: a `latvox {}` part is drawn and sliced from its mesh, not its settings: make it with `latvox {} --part {} -o part.stl`, then use part.stl (parts traced from their settings: {})",
+                path.display(),
+                c.name,
+                c.name,
+                path.display(),
+                names_with(|c| c.trace.is_some())
+            )))
+        }
+        None => {
+            return Err(Error::invalid(format!(
+                "{}: a part file needs `command` ({})",
+                path.display(),
+                names_with(|c| c.trace.is_some())
+            )))
+        }
     };
     let argv = expand_table(command, Vec::new(), table, path)?;
     let m = command

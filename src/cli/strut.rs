@@ -24,8 +24,10 @@ Examples:
   latvox strut --cell bcc --radius 0.4 --blend 0.3 --size 42,30,12 --cell-size 6 -o bcc.stl
 
   # A cell of your own: nodes in unit-cell coordinates, struts as node pairs, and optionally a
-  # radius factor per node (struts between nodes of different factors are tapered)
-  echo '{\"nodes\": [[0,0,0],[1,1,1],[1,0,0]], \"struts\": [[0,1],[0,2]], \"radii\": [1.5,1,1]}' > cell.json
+  # radius factor per node (struts between nodes of different factors are tapered); here the
+  # centre joined to four corners, a tetrahedral net, thick at the centre
+  echo '{\"nodes\": [[0.5,0.5,0.5],[0,0,0],[1,0,0],[0,1,0],[0,0,1]],
+         \"struts\": [[0,1],[0,2],[0,3],[0,4]], \"radii\": [1.5,0.8,0.8,0.8,0.8]}' > cell.json
   latvox strut --cell cell.json --density 0.15 --cells 5 --cell-size 4 -o custom.stl
 
   # The same lattice as 3MF beams (each strut a beam, the box a clipping mesh): kilobytes

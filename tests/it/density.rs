@@ -1,14 +1,15 @@
 //! Exact density for every type and structure at 0.10, 0.20, 0.30 and 0.50: the volume fraction
 //! measured on the final mesh is within 0.002 of the target; the mesh verified closed, manifold and
-//! outward (the checks `self_intersect.rs` holds to CGAL's). The main tier meets every type and
-//! structure at one of the four densities (each density in turn); the long tier, all four.
+//! outward (the checks `self_intersect.rs` holds to CGAL's). The main tier meets every type, as a
+//! net or a sheet in turn, at one of the four densities in turn; the long tier, every type and
+//! structure at all four.
 
 use latvox::tpms::{Domain, Structure, Surface, TpmsJob};
 
 const TARGETS: [f64; 4] = [0.10, 0.20, 0.30, 0.50];
 
 #[test]
-fn every_type_and_structure_hits_a_target_within_0_002() {
+fn every_type_hits_a_target_within_0_002() {
     hits_targets(false);
 }
 
@@ -21,8 +22,11 @@ fn every_type_and_structure_hits_its_target_within_0_002() {
 fn hits_targets(all: bool) {
     let mut failures = Vec::new();
     let mut turn = 0;
-    for surface in Surface::ALL {
+    for (i, surface) in Surface::ALL.into_iter().enumerate() {
         for structure in [Structure::Net, Structure::Sheet] {
+            if !all && (structure == Structure::Sheet) != (i % 2 == 1) {
+                continue;
+            }
             turn += 1;
             let targets = if all {
                 &TARGETS[..]

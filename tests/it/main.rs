@@ -31,6 +31,7 @@ mod slice;
 mod slurm;
 mod strut;
 mod strut_cli;
+mod tidy;
 mod tiling;
 mod topopt;
 mod tpms_cli;
