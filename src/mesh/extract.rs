@@ -163,6 +163,29 @@ impl KeyedMesh {
         })
     }
 
+    /// Edges of one triangle only: where the mesh has a hole. OpenVDB's meshes of a level set are
+    /// closed; on voxels too coarse for a lattice's members (a void thinner than a voxel where
+    /// it meets the box) they can come out open.
+    pub fn open_edges(&self) -> u64 {
+        let mut edges: Vec<u64> = self
+            .triangles()
+            .flat_map(|[a, b, c]| [(a, b), (b, c), (c, a)])
+            .map(|(a, b)| (a.min(b) as u64) << 32 | a.max(b) as u64)
+            .collect();
+        edges.sort_unstable();
+        let mut open = 0;
+        let mut i = 0;
+        while i < edges.len() {
+            let mut j = i + 1;
+            while j < edges.len() && edges[j] == edges[i] {
+                j += 1;
+            }
+            open += (j - i == 1) as u64;
+            i = j;
+        }
+        open
+    }
+
     /// Number of triangles the quads make (a stored triangle counts once).
     pub fn triangle_count(&self) -> usize {
         self.quads

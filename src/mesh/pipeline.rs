@@ -309,6 +309,9 @@ pub struct Measured {
     pub fragments: Fragments,
     /// Meshing statistics of this level.
     pub meshing: MeshingStats,
+    /// Edges of one facet only in what was meshed (the whole part or its template; 0 where
+    /// nothing is held): holes that voxels too coarse for the members left.
+    pub open_edges: u64,
 }
 
 /// Meshes or measures the solid at `level` on its route.
@@ -367,12 +370,18 @@ pub fn measure_observed<F: Family>(
             (Made::TilePieces(found), v, f, stats)
         }
     };
+    let open_edges = match &made {
+        Made::Whole(mesh) => mesh.open_edges(),
+        Made::Template(t) | Made::Tiles(Some(t)) => t.mesh.open_edges(),
+        _ => 0,
+    };
     Ok(Measured {
         level,
         fraction: family.fraction(volume, &solid.bounds()),
         made,
         fragments,
         meshing,
+        open_edges,
     })
 }
 
@@ -553,7 +562,8 @@ pub fn solve<F: Family>(
         };
     }
     let best = best.expect("at least one meshing");
-    let met = (best.fraction - target).abs() <= PROMISE;
+    // A part with holes does not meet its density: the voxels are too coarse for its members.
+    let met = (best.fraction - target).abs() <= PROMISE && best.open_edges == 0;
     Ok(Solved {
         best,
         tried,

@@ -135,12 +135,19 @@ pub fn search<T>(
     };
     coarser.sort_by_key(|m| m.resolution);
     if let Some(miss) = coarser.first().filter(|m| m.resolution == start) {
-        passed_over.push(format!(
-            "at {} voxels per cell no level gives density {} (closest {:.4}): the voxels are too coarse for the lattice's members",
-            miss.resolution,
-            request.density.unwrap_or(f64::NAN),
-            miss.closest
-        ));
+        let target = request.density.unwrap_or(f64::NAN);
+        passed_over.push(if (miss.closest - target).abs() <= PROMISE {
+            // The density was met, but the mesh had holes.
+            format!(
+                "at {} voxels per cell the part comes out with holes: the voxels are too coarse for the lattice's members",
+                miss.resolution
+            )
+        } else {
+            format!(
+                "at {} voxels per cell no level gives density {target} (closest {:.4}): the voxels are too coarse for the lattice's members",
+                miss.resolution, miss.closest
+            )
+        });
     }
     let raised = match passed_over.first() {
         Some(why) if !request.auto => {

@@ -96,3 +96,74 @@ fn a_density_outside_the_solid_range_is_refused_with_the_range() {
         }
     }
 }
+
+/// A library user matches on what went wrong and reads its data: an infeasible density carries
+/// the range the lattice holds together in, a setting out of its range names the setting, and
+/// voxels too coarse for fixed voxels carry the resolution that works.
+#[test]
+fn refusals_are_typed_errors_that_carry_their_data() {
+    use latvox::tpms::{Domain, Structure, Surface, TpmsJob};
+    use latvox::Error;
+    let job = |density: f64, resolution: u32, auto_resolution: bool| TpmsJob {
+        surface: Surface::P,
+        structure: Structure::Net,
+        density,
+        domain: Domain::from_cells([2; 3], [5.0; 3], [0.0; 3]).unwrap(),
+        resolution,
+        adaptivity: 0.0,
+        allow_islands: false,
+        auto_resolution,
+        verify: latvox::verify::Verify::Fast,
+        instancing: true,
+        tile: None,
+        memory: None,
+        keep_fragments: false,
+        grading: None,
+        blend: None,
+        cell_map: None,
+    };
+    let run = |j: TpmsJob| j.run(&latvox::progress::Progress::hidden()).map(|_| ());
+    let range = latvox::tpms::calibrate::feasible(Surface::P, Structure::Net);
+    match run(job(range.min - 0.02, 24, true)) {
+        Err(Error::Infeasible {
+            setting,
+            value,
+            min,
+            max,
+            message,
+        }) => {
+            assert_eq!(setting, "density");
+            assert_eq!(value, range.min - 0.02);
+            assert_eq!((min, max), (range.min, range.max));
+            assert!(message.contains(&format!("{:.3}", range.min)), "{message}");
+        }
+        other => panic!("an infeasible density: {other:?}"),
+    }
+    match run(job(1.5, 24, true)) {
+        Err(e @ Error::Setting { .. }) => {
+            let Error::Setting { setting, .. } = &e else {
+                unreachable!()
+            };
+            assert_eq!(setting, "density");
+            assert_eq!(e.exit_code(), 2);
+        }
+        other => panic!("a density out of (0, 1): {other:?}"),
+    }
+    // A thin sheet on fixed, coarse voxels: refused with the resolution that works, which works.
+    let sheet = |resolution: u32| TpmsJob {
+        structure: Structure::Sheet,
+        density: 0.08,
+        ..job(0.08, resolution, false)
+    };
+    match run(sheet(8)) {
+        Err(Error::Resolution {
+            requested, needed, ..
+        }) => {
+            assert_eq!(requested, 8);
+            let needed = needed.expect("the refusal names a resolution");
+            assert!(needed > 8);
+            run(sheet(needed)).expect("the resolution named works");
+        }
+        other => panic!("voxels too coarse for the sheet: {other:?}"),
+    }
+}
