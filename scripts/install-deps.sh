@@ -38,8 +38,8 @@ PKGS=(
 )
 if [ "$TESTS" -eq 1 ]; then
   PKGS+=(
-    # independent checkers
-    admesh libopenvdb-tools
+    # independent checkers; GNU time reads a child's peak memory from the kernel
+    admesh libopenvdb-tools time
     # fgm tests: OpenVDB's own Python module reads the .vdb grids back
     python3-openvdb
     # Python for the reference optimisers and checkers, and the libraries the PyPI gmsh wheel

@@ -4,19 +4,32 @@
 //! matches its triangle count, and its enclosed volume (divergence theorem) is the reported one
 //! and the requested density.
 
-use crate::common;
 use crate::common::*;
 use std::io::Read;
 
-/// Runs latvox with `args` in `dir`; returns (exit code, peak RSS in bytes) from wait4.
+/// Runs latvox with `args` in `dir`; returns (exit code, peak RSS in bytes), as GNU time reads
+/// them from the kernel (`wait4`). Not from this process's own `wait4`: Linux hands a child the
+/// peak resident memory of the process it was forked from when it execs, and this test process
+/// (every test in it, on threads) may have grown far larger than the part being measured.
 fn run_measured(args: &[&str], dir: &std::path::Path) -> (i32, u64) {
-    let m = common::child::run_measured(
-        latvox()
-            .args(args)
-            .current_dir(dir)
-            .stdout(std::process::Stdio::null()),
-    );
-    (m.code, m.peak_rss)
+    let peak = tempfile::NamedTempFile::new().unwrap();
+    let status = std::process::Command::new("/usr/bin/time")
+        .args(["-f", "%M", "-o"])
+        .arg(peak.path())
+        .arg(env!("CARGO_BIN_EXE_latvox"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::null())
+        .status()
+        .expect("/usr/bin/time (Debian's time: scripts/install-deps.sh --tests)");
+    let text = std::fs::read_to_string(peak.path()).unwrap();
+    // The last line holds %M, in KiB (a line before it says when the command failed).
+    let kib: u64 = text
+        .lines()
+        .last()
+        .and_then(|l| l.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no peak memory from GNU time: {text}"));
+    (status.code().unwrap_or(-1), kib * 1024)
 }
 
 /// Streams a binary STL: (triangles, enclosed volume).

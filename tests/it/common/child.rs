@@ -20,7 +20,10 @@ impl Measured {
     }
 }
 
-/// Spawns `cmd` and waits for it with `wait4`.
+/// Spawns `cmd` and waits for it with `wait4`. Its peak memory is right only when this process
+/// is small: Linux gives a child, when it execs, the peak resident memory of the process it was
+/// forked from (the benchmarks are their own small processes; in the test binary, where other
+/// tests' memory counts, `scale.rs` measures through GNU time instead).
 pub fn run_measured(cmd: &mut Command) -> Measured {
     let start = Instant::now();
     let child = cmd.spawn().expect("spawn the child");
