@@ -122,23 +122,7 @@ fn main() {
     }
     let (name, sub) = matches.subcommand().expect("clap requires a subcommand");
     let command = cli::command::find(name).expect("every subcommand is in cli::COMMANDS");
-    // The part file (if asked for) is written once the part is made; its folder must take it.
-    let save_part = sub
-        .try_get_one::<std::path::PathBuf>("save_part")
-        .ok()
-        .flatten();
-    if let Some(p) = save_part {
-        if let Err(e) = latvox::io::atomic::check_writable(p) {
-            eprintln!("latvox: {}", one_line(&e));
-            std::process::exit(e.exit_code());
-        }
-    }
-    let result = (command.run)(sub, cli.quiet).and_then(|code| {
-        if let Some(path) = save_part {
-            cli::part::save(path, command, sub)?;
-        }
-        Ok(code)
-    });
+    let result = cli::execute(command, sub, cli.quiet);
     match result {
         Ok(code) => std::process::exit(code),
         Err(e) => {

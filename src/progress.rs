@@ -6,8 +6,20 @@
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
-use std::sync::mpsc;
+use std::sync::{mpsc, RwLock};
 use std::time::Duration;
+
+/// What hears of each stage as it starts (see [`listen`]).
+pub type Listener = Box<dyn Fn(&str) + Send + Sync>;
+
+static LISTENER: RwLock<Option<Listener>> = RwLock::new(None);
+
+/// From now on, `listener` is called with each stage's name as the stage starts, from whatever
+/// thread starts it, shown or not (`None`: no one is). For a program that shows latvox's progress
+/// its own way (the Python package's callback or bar).
+pub fn listen(listener: Option<Listener>) {
+    *LISTENER.write().unwrap_or_else(|e| e.into_inner()) = listener;
+}
 
 /// Shows stage spinners, or nothing.
 #[derive(Debug, Clone, Copy)]
@@ -38,6 +50,9 @@ impl Progress {
     /// Starts a stage; its spinner appears once the stage has run for a second, and disappears
     /// when the returned guard is dropped.
     pub fn stage(&self, name: &str) -> Stage {
+        if let Some(l) = LISTENER.read().unwrap_or_else(|e| e.into_inner()).as_ref() {
+            l(name);
+        }
         if !self.enabled || self.lines {
             if self.enabled {
                 eprintln!("progress: {name}");

@@ -208,7 +208,7 @@ pub fn run(a: &InterpretArgs, quiet: bool) -> Result<i32> {
     }
     summary(r, a, &part.images);
     for w in r.warnings() {
-        eprintln!("latvox: warning: {w}");
+        super::out::warning(&w);
     }
     // Features the printer cannot make that remain after the last pass are defects too.
     Ok(r.verdict().exit_code())

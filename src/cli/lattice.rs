@@ -251,7 +251,7 @@ impl MeshArgs {
             write_json(r, report)?;
         }
         for w in &part.warnings {
-            eprintln!("latvox: warning: {w}");
+            super::out::warning(w);
         }
         Ok(part.verdict().exit_code())
     }

@@ -20,7 +20,7 @@ pub mod tpms;
 pub mod view;
 
 use latvox::Result;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Every subcommand, in the order the help lists them.
 pub(crate) const COMMANDS: &[&command::Command] = &[
@@ -37,6 +37,60 @@ pub(crate) const COMMANDS: &[&command::Command] = &[
     &slice::COMMAND,
     &batch::COMMAND,
 ];
+
+/// Runs the command `name` (or a former name) on `args`, its options as they follow its name on
+/// the command line (a part file's put in where `--part` names one); the exit code. For a
+/// program that runs latvox's commands in its own process (the Python package).
+#[allow(dead_code)] // the binary parses its whole command line itself
+pub(crate) fn run_one(name: &str, args: Vec<String>, quiet: bool) -> Result<i32> {
+    let command = command::find(name)
+        .ok_or_else(|| latvox::Error::invalid(format!("unknown command '{name}'")))?;
+    let args = match command.part {
+        Some(_) => part::expand(command, args)?,
+        None => args,
+    };
+    let matches = command
+        .clap()
+        .no_binary_name(true)
+        .try_get_matches_from(args)
+        .map_err(|e| {
+            // The option a bad value was given to, as its name: "--density <DENSITY>" → density.
+            let setting = e.get(clap::error::ContextKind::InvalidArg).map(|a| {
+                a.to_string()
+                    .trim_start_matches('-')
+                    .split([' ', '='])
+                    .next()
+                    .unwrap_or_default()
+                    .to_string()
+            });
+            match setting {
+                Some(s) if !s.is_empty() && !s.starts_with('<') => {
+                    latvox::Error::setting(s, clap_message(e))
+                }
+                _ => latvox::Error::invalid(clap_message(e)),
+            }
+        })?;
+    execute(command, &matches, quiet)
+}
+
+/// Runs `command` on its parsed options (`quiet`: no progress) and writes the part file
+/// `--save-part` asks for once the part is made; the exit code.
+pub(crate) fn execute(
+    command: &command::Command,
+    sub: &clap::ArgMatches,
+    quiet: bool,
+) -> Result<i32> {
+    // The part file is written once the part is made; its folder must take it.
+    let save_part = sub.try_get_one::<PathBuf>("save_part").ok().flatten();
+    if let Some(p) = save_part {
+        latvox::io::atomic::check_writable(p)?;
+    }
+    let code = (command.run)(sub, quiet)?;
+    if let Some(p) = save_part {
+        part::save(p, command, sub)?;
+    }
+    Ok(code)
+}
 
 pub(crate) fn split3<T: Copy>(
     s: &str,

@@ -3,9 +3,30 @@
 //! `println!` would panic.
 
 use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Writes `args` and a newline to stdout; on a closed pipe, exits with 0 at once.
+static SILENT: AtomicBool = AtomicBool::new(false);
+
+/// Whether the commands print their summaries and warnings (`true`: they do not — a program that
+/// runs them in its own process and takes their reports instead, the Python package).
+#[allow(dead_code)] // the binary always prints
+pub(crate) fn silence(silent: bool) {
+    SILENT.store(silent, Ordering::Relaxed);
+}
+
+/// Prints a warning on stderr (`latvox: warning: …`), unless silenced.
+pub(crate) fn warning(w: &str) {
+    if !SILENT.load(Ordering::Relaxed) {
+        eprintln!("latvox: warning: {w}");
+    }
+}
+
+/// Writes `args` and a newline to stdout; on a closed pipe, exits with 0 at once. Nothing when
+/// silenced.
 pub(crate) fn line(args: std::fmt::Arguments) {
+    if SILENT.load(Ordering::Relaxed) {
+        return;
+    }
     let mut out = std::io::stdout().lock();
     if let Err(e) = out.write_fmt(args).and_then(|()| out.write_all(b"\n")) {
         if e.kind() == std::io::ErrorKind::BrokenPipe {

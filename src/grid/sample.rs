@@ -24,9 +24,13 @@ impl Grid {
     }
 
     /// Samples `field` on the narrow band within the leaf blocks that cover `region` (sample
-    /// indices of `spec`).
+    /// indices of `spec`). Every block the band does not reach takes the sign of the field at its
+    /// first sample. (OpenVDB's flood fill from the band, used before, gave a whole internal node
+    /// with no band in it the sign of its neighbour in key order: a gyroid of 11×11×11 cells on 36
+    /// voxels a cell, meshed in tiles of 288, came out with a slab above its box marked inside.)
     pub fn sample_box(field: &dyn Field, spec: GridSpec, region: IndexBox) -> Result<Grid> {
-        Self::sample_blocks(field, spec, region, None)
+        let inside = |first: [i64; 3]| field.value(spec.point(first)) < 0.0;
+        Self::sample_blocks(field, spec, region, Some(&inside))
     }
 
     /// As [`Grid::sample`], the sign of every block the band does not reach given by `inside`

@@ -7,10 +7,77 @@ use crate::error::{Error, Result};
 use crate::geom::Mesh;
 use crate::io::sink::{MeshCollector, MeshSink, StlSink, ThreeMfSink, Triangle};
 use crate::io::{Format, StlFormat};
+use std::cell::RefCell;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// Half-width of the level set written to `.vdb`, in voxels (OpenVDB's default band).
 const VDB_HALF_WIDTH: f64 = 3.0;
+
+/// How this thread's outputs are written, when a caller runs a command under [`capturing`] or
+/// [`stoppable`].
+struct Session {
+    /// Mesh outputs kept in memory instead of written (`None`: written).
+    kept: Option<Vec<(PathBuf, Mesh)>>,
+    /// Set by the caller to stop the work.
+    stop: Arc<AtomicBool>,
+}
+
+thread_local! {
+    static SESSION: RefCell<Option<Session>> = const { RefCell::new(None) };
+}
+
+/// Runs `f` with every mesh output this thread writes (through [`MeshFile::sink`] or
+/// [`MeshFile::save`], whatever its format; `.vdb` level sets are still written) kept in memory
+/// instead of written: the caller gets the meshes, by the paths they would have gone to, and no
+/// file appears. A caller that wants the mesh itself (the Python package) runs a command this way.
+/// Stops as [`stoppable`] does.
+pub fn capturing<R>(stop: Arc<AtomicBool>, f: impl FnOnce() -> R) -> (R, Vec<(PathBuf, Mesh)>) {
+    let (r, kept) = in_session(Some(Vec::new()), stop, f);
+    (r, kept.unwrap_or_default())
+}
+
+/// Runs `f` with its outputs written as usual, until `stop` is set: then the next batch of
+/// triangles a mesh output takes, or its commit, fails ("stopped") and the output is not written.
+pub fn stoppable<R>(stop: Arc<AtomicBool>, f: impl FnOnce() -> R) -> R {
+    in_session(None, stop, f).0
+}
+
+fn in_session<R>(
+    kept: Option<Vec<(PathBuf, Mesh)>>,
+    stop: Arc<AtomicBool>,
+    f: impl FnOnce() -> R,
+) -> (R, Option<Vec<(PathBuf, Mesh)>>) {
+    let outer = SESSION.replace(Some(Session { kept, stop }));
+    let r = f();
+    let ours = SESSION.replace(outer).and_then(|s| s.kept);
+    (r, ours)
+}
+
+/// This thread's stop flag, and whether it keeps meshes, when it runs in a session.
+fn session() -> Option<(Arc<AtomicBool>, bool)> {
+    SESSION.with_borrow(|s| s.as_ref().map(|s| (s.stop.clone(), s.kept.is_some())))
+}
+
+/// "stopped", once `stop` is set.
+fn check_stop(stop: Option<&Arc<AtomicBool>>) -> Result<()> {
+    match stop {
+        Some(s) if s.load(Ordering::Relaxed) => Err(Error::invalid("stopped")),
+        _ => Ok(()),
+    }
+}
+
+/// Keeps `mesh` for `path` when this thread keeps meshes; gives it back otherwise.
+fn keep(path: &Path, mesh: Mesh) -> Option<Mesh> {
+    SESSION.with_borrow_mut(|s| match s.as_mut().and_then(|s| s.kept.as_mut()) {
+        Some(kept) => {
+            kept.push((path.to_path_buf(), mesh));
+            None
+        }
+        None => Some(mesh),
+    })
+}
 
 /// What an output file holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -87,20 +154,48 @@ impl MeshFile {
         } else {
             StlFormat::Binary
         };
-        Ok(match self.written {
-            Written::Mesh(Format::Stl) => FileSink::Stl(StlSink::create(&self.path, stl)?),
-            Written::Mesh(Format::ThreeMf) => FileSink::ThreeMf(ThreeMfSink::create(&self.path)?),
-            Written::Mesh(Format::Obj | Format::Off | Format::Ply) | Written::Vdb => {
-                FileSink::Indexed {
-                    file: self.clone(),
-                    collector: MeshCollector::default(),
-                }
-            }
-        })
+        let (stop, keeps) = match session() {
+            Some((stop, keeps)) => (Some(stop), keeps),
+            None => (None, false),
+        };
+        let indexed = || Target::Indexed {
+            file: self.clone(),
+            collector: MeshCollector::default(),
+        };
+        let target = match self.written {
+            Written::Mesh(_) if keeps => indexed(),
+            Written::Mesh(Format::Stl) => Target::Stl(StlSink::create(&self.path, stl)?),
+            Written::Mesh(Format::ThreeMf) => Target::ThreeMf(ThreeMfSink::create(&self.path)?),
+            Written::Mesh(Format::Obj | Format::Off | Format::Ply) | Written::Vdb => indexed(),
+        };
+        Ok(FileSink { target, stop })
     }
 
-    /// Writes `mesh` to the file atomically, its vertices indexed as they are.
+    /// Writes `mesh` to the file atomically, its vertices indexed as they are (or keeps a copy,
+    /// where this thread is [`capturing`]).
     pub fn save(&self, mesh: &Mesh) -> Result<()> {
+        match (self.written, session()) {
+            (_, Some((stop, _))) if stop.load(Ordering::Relaxed) => check_stop(Some(&stop)),
+            (Written::Mesh(_), Some((_, true))) => {
+                keep(&self.path, mesh.clone());
+                Ok(())
+            }
+            _ => self.write(mesh),
+        }
+    }
+
+    /// Writes `mesh`, or keeps it where this thread is [`capturing`].
+    fn save_owned(&self, mesh: Mesh) -> Result<()> {
+        match self.written {
+            Written::Mesh(_) => match keep(&self.path, mesh) {
+                Some(mesh) => self.write(&mesh),
+                None => Ok(()),
+            },
+            Written::Vdb => self.write(&mesh),
+        }
+    }
+
+    fn write(&self, mesh: &Mesh) -> Result<()> {
         match self.written {
             Written::Mesh(format) => crate::io::atomic::write_atomic(&self.path, |w| {
                 crate::io::write(mesh, format, self.ascii, w)
@@ -143,12 +238,19 @@ fn mean_edge(mesh: &Mesh) -> Option<f64> {
 /// A sink into a [`MeshFile`]: STL and 3MF stream to a temporary file as the triangles come;
 /// OBJ, OFF, PLY (which list each vertex once) and `.vdb` gather the triangles (welding
 /// bit-identical corners, as [`MeshCollector`] does) and write them at [`FileSink::commit`].
-pub enum FileSink {
+/// Under [`capturing`], every mesh is gathered and kept; under [`capturing`] or [`stoppable`],
+/// it fails once the caller stops the work.
+pub struct FileSink {
+    target: Target,
+    stop: Option<Arc<AtomicBool>>,
+}
+
+enum Target {
     /// Binary or ASCII STL, streamed.
     Stl(StlSink),
     /// 3MF, streamed.
     ThreeMf(ThreeMfSink),
-    /// OBJ, OFF, PLY or `.vdb`: gathered, written at commit.
+    /// OBJ, OFF, PLY or `.vdb` (or any mesh kept): gathered, written (or kept) at commit.
     Indexed {
         /// The file to write.
         file: MeshFile,
@@ -158,27 +260,28 @@ pub enum FileSink {
 }
 
 impl FileSink {
-    /// Moves the finished file into place.
+    /// Moves the finished file into place (or keeps the mesh).
     pub fn commit(self) -> Result<()> {
-        match self {
-            FileSink::Stl(s) => s.commit(),
-            FileSink::ThreeMf(s) => s.commit(),
-            FileSink::Indexed { file, collector } => file.save(&collector.mesh),
+        check_stop(self.stop.as_ref())?;
+        match self.target {
+            Target::Stl(s) => s.commit(),
+            Target::ThreeMf(s) => s.commit(),
+            Target::Indexed { file, collector } => file.save_owned(collector.mesh),
         }
     }
 
     /// Sets the voxel size of a `.vdb`'s level set (the part's own voxels), mm.
     pub fn set_voxel(&mut self, voxel: f64) {
-        if let FileSink::Indexed { file, .. } = self {
+        if let Target::Indexed { file, .. } = &mut self.target {
             *file = file.clone().with_voxel(voxel);
         }
     }
 
     fn inner(&mut self) -> &mut dyn MeshSink {
-        match self {
-            FileSink::Stl(s) => s,
-            FileSink::ThreeMf(s) => s,
-            FileSink::Indexed { collector, .. } => collector,
+        match &mut self.target {
+            Target::Stl(s) => s,
+            Target::ThreeMf(s) => s,
+            Target::Indexed { collector, .. } => collector,
         }
     }
 }
@@ -189,6 +292,7 @@ impl MeshSink for FileSink {
     }
 
     fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
+        check_stop(self.stop.as_ref())?;
         self.inner().triangles(batch)
     }
 

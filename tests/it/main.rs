@@ -24,6 +24,7 @@ mod graded;
 mod instancing;
 mod interpret;
 mod part_files;
+mod python;
 mod render;
 mod scale;
 mod self_intersect;

@@ -201,3 +201,51 @@ fn a_streamed_3mf_holds_the_same_solid_as_the_stl() {
         assert_eq!(names, ["p.3mf", "p.stl"], "{route}");
     }
 }
+
+/// Tiles whose grids hold a whole OpenVDB internal node with no band in it: the node's sign is
+/// the field's, not its neighbour's. (With the sign flood-filled from the band, this gyroid of
+/// 7×7×7 cells on tiles of 144 came out at 0.258 with a slab above its box, open.)
+#[test]
+fn tiles_with_an_empty_internal_node_keep_the_box() {
+    let dir = tempdir();
+    let o = run(
+        &[
+            "tpms",
+            "--type",
+            "gyroid",
+            "--density",
+            "0.3",
+            "--cells",
+            "7",
+            "--cell-size",
+            "5",
+            "--resolution",
+            "36",
+            "--fixed-resolution",
+            "--tile",
+            "144",
+            "--verify",
+            "fast",
+            "-q",
+            "-o",
+            "g.stl",
+        ],
+        dir.path(),
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let (faces, watertight, volume) = trimesh_summary(&dir.path().join("g.stl"));
+    assert!(faces > 0 && watertight);
+    assert!((volume / 35f64.powi(3) - 0.3).abs() <= 0.002, "{volume}");
+    let (lo, hi) = bounds(&read_stl(&dir.path().join("g.stl")));
+    for a in 0..3 {
+        assert!(
+            lo[a] >= -1e-4 && hi[a] <= 35.0 + 1e-4,
+            "beyond the box: {lo:?} {hi:?}"
+        );
+    }
+}
