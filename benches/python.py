@@ -12,7 +12,8 @@ medians and the median of the pair-by-pair ratios are printed.
    makes the same cells at 13 voxels a cell at the solid fraction PyScaffolder's part has, and
    verifies it. Time and peak memory of each, triangles, the density each reaches.
 2. The same latvox part from Python (`latvox.tpms(..., output=...)`) and from the command line
-   (`latvox tpms ... -o`): the Python call's overhead.
+   (`latvox tpms ... -o`): the Python call's overhead; and the part kept in memory as NumPy
+   arrays (no output) beside the command line writing it.
 """
 
 import argparse
@@ -60,8 +61,11 @@ print(json.dumps({"seconds": dt, "triangles": len(m.faces),
 PART = ["--type", "gyroid", "--density", "0.3", "--cells", "6", "--cell-size", "5"]
 
 OVERHEAD = r"""
-import sys, latvox
-latvox.tpms(type="gyroid", density=0.3, cells=6, cell_size=5.0, output=sys.argv[1])
+import json, sys, time, latvox
+t = time.perf_counter()
+m = latvox.tpms(type="gyroid", density=0.3, cells=6, cell_size=5.0,
+                output=sys.argv[1] if sys.argv[1] != "-" else None)
+print(json.dumps({"seconds": time.perf_counter() - t}))
 """
 
 
@@ -116,17 +120,27 @@ def main():
 
     with tempfile.TemporaryDirectory() as d:
         out = os.path.join(d, "g.stl")
-        py, cli = [], []
+        py, mem, cli, call, call_mem = [], [], [], [], []
         timed([exe, "tpms", *PART, "-o", out, "-q"])
         for _ in range(a.runs):
-            py.append(timed([sys.executable, "-c", OVERHEAD, out]))
+            t = time.perf_counter()
+            call.append(run([sys.executable, "-c", OVERHEAD, out])["seconds"])
+            py.append(time.perf_counter() - t)
             cli.append(timed([exe, "tpms", *PART, "-o", out, "-q"]))
+            t = time.perf_counter()
+            call_mem.append(run([sys.executable, "-c", OVERHEAD, "-"])["seconds"])
+            mem.append(time.perf_counter() - t)
         start = median([timed([sys.executable, "-c", "import latvox"]) for _ in range(a.runs)])
-    ratio = median([p / c for p, c in zip(py, cli)])
-    print("2. `tpms " + " ".join(PART) + "` written to STL, whole processes")
-    print(f"command line {median(cli):.3f} s; Python {median(py):.3f} s "
-          f"(of which starting Python and importing latvox {start:.3f} s); "
-          f"Python / command line, median of the pairs: {ratio:.3f}")
+    print("2. `tpms " + " ".join(PART) + "`, whole processes (medians)")
+    print(f"- command line, written to STL: {median(cli):.3f} s")
+    print(f"- Python, written to STL (output=): process {median(py):.3f} s, the call "
+          f"{median(call):.3f} s; the call / the command line, median of the pairs: "
+          f"{median([p / c for p, c in zip(call, cli)]):.3f} (the process: "
+          f"{median([p / c for p, c in zip(py, cli)]):.3f})")
+    print(f"- Python, kept in memory as NumPy arrays: process {median(mem):.3f} s, the call "
+          f"{median(call_mem):.3f} s; the call / the command line: "
+          f"{median([m / c for m, c in zip(call_mem, cli)]):.3f}")
+    print(f"- of each Python process, starting Python and importing latvox: {start:.3f} s")
 
 
 if __name__ == "__main__":

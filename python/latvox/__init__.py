@@ -115,9 +115,40 @@ class Mesh:
             raise InputError(
                 f"a mesh is vertices (N, 3) and faces (M, 3), got {v.shape} and {f.shape}"
             )
-        self.vertices: np.ndarray = v
-        self.faces: np.ndarray = f
+        self._arrays: Optional[Tuple[np.ndarray, np.ndarray]] = (v, f)
+        self._file: Optional[str] = None
         self.report: Dict[str, Any] = report if report is not None else {}
+
+    @classmethod
+    def _written(cls, path: str, report: Dict[str, Any]) -> "Mesh":
+        """The mesh a command wrote to `path`, read when its arrays are first asked for."""
+        m = cls.__new__(cls)
+        m._arrays, m._file, m.report = None, path, report
+        return m
+
+    def _load(self) -> Tuple[np.ndarray, np.ndarray]:
+        if self._arrays is None:
+            loaded = Mesh.load(self._file)
+            self._arrays = (loaded.vertices, loaded.faces)
+        return self._arrays
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """(N, 3) float64, mm."""
+        return self._load()[0]
+
+    @vertices.setter
+    def vertices(self, v: Any) -> None:
+        self._arrays = (np.ascontiguousarray(v, dtype=np.float64), self.faces)
+
+    @property
+    def faces(self) -> np.ndarray:
+        """(M, 3) uint32 vertex indices, wound outward."""
+        return self._load()[1]
+
+    @faces.setter
+    def faces(self, f: Any) -> None:
+        self._arrays = (self.vertices, np.ascontiguousarray(f, dtype=np.uint32))
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> "Mesh":
@@ -149,6 +180,8 @@ class Mesh:
         return trimesh.Trimesh(vertices=self.vertices, faces=self.faces, process=False)
 
     def __repr__(self) -> str:
+        if self._arrays is None:
+            return f"latvox.Mesh(written to {self._file!r})"
         return f"latvox.Mesh({len(self.vertices)} vertices, {len(self.faces)} faces)"
 
 
@@ -326,16 +359,18 @@ def _run(
     progress: Union[bool, Callable[[str], Any], None] = None,
     threads: Optional[int] = None,
     keep: bool = True,
-    read: Callable[[str, List[Tuple[str, np.ndarray, np.ndarray]], Dict[str, Any]], Any],
+    read: Callable[[str, List[Tuple[str, np.ndarray, np.ndarray]], Dict[str, Any], bool], Any],
 ) -> Any:
     """Runs `command` with the keyword arguments `given`; `output`: the file it writes to,
     in a temporary folder, unless the caller names one; `read` makes the result of the written
-    output's path, the meshes kept and the report."""
+    output's path, the meshes kept, the report and whether the caller named the output (and so
+    it stays)."""
     opts = _options(command)
     with tempfile.TemporaryDirectory(prefix="latvox-") as folder:
         given = dict(given)
         # Outputs latvox names itself are kept in memory; one the caller names is written.
-        keep = keep and output is not None and given.get("output") is None
+        named = output is not None and given.get("output") is not None
+        keep = keep and output is not None and not named
         if output is not None and given.get("output") is None:
             given["output"] = os.path.join(folder, output)
         if "report" in opts and given.get("report") is None:
@@ -354,7 +389,7 @@ def _run(
         if "report" in given and os.path.exists(given["report"]):
             with open(given["report"]) as r:
                 report = json.load(r)
-        result = read(given.get("output", ""), kept, report)
+        result = read(given.get("output", ""), kept, report, named)
     if code != 0 and strict:
         raise DefectError(
             f"{command}: the result has defects (see its report)", result, report
@@ -362,13 +397,16 @@ def _run(
     return result
 
 
-def _mesh_result(path: str, kept, report) -> Mesh:
+def _mesh_result(path: str, kept, report, named: bool) -> Mesh:
     for p, v, f in kept:
         if os.path.abspath(p) == os.path.abspath(path):
             return Mesh(v, f, report)
     if kept:
         _, v, f = kept[0]
         return Mesh(v, f, report)
+    if named:
+        # The caller's file: read only if its arrays are asked for.
+        return Mesh._written(os.fspath(path), report)
     m = Mesh.load(path)
     m.report = report
     return m
@@ -406,7 +444,7 @@ def interpret(input: Any, *, strict: bool = False, progress=None,
 
 def topopt(*, strict: bool = False, progress=None, threads: Optional[int] = None,
            **options) -> Density:
-    def read(path, kept, report):
+    def read(path, kept, report, named):
         return Density(np.load(path), report)
 
     return _run("topopt", options, output="densities.npy", strict=strict, progress=progress,
@@ -417,7 +455,7 @@ def check(mesh: Any, *, strict: bool = False, progress=None, threads: Optional[i
           **options) -> Dict[str, Any]:
     options["file"] = mesh
     return _run("check", options, meshes=("file",), strict=strict, progress=progress,
-                threads=threads, read=lambda path, kept, report: report)
+                threads=threads, read=lambda path, kept, report, named: report)
 
 
 def repair(mesh: Any, *, strict: bool = False, progress=None, threads: Optional[int] = None,
@@ -458,7 +496,7 @@ def slice(mesh: Any, *, strict: bool = False, progress=None, threads: Optional[i
     meshes = () if isinstance(mesh, (str, os.PathLike)) else ("input",)
     return _run("slice", options, meshes=meshes, output="layers.cli", strict=strict,
                 progress=progress, threads=threads,
-                read=lambda path, kept, report: _read_cli(path))
+                read=lambda path, kept, report, named: _read_cli(path))
 
 
 def render(part: Any, width: int = 800, height: int = 600, *, progress=None,
@@ -468,7 +506,7 @@ def render(part: Any, width: int = 800, height: int = 600, *, progress=None,
     options.update(input=part, width=width, height=height)
     meshes = () if isinstance(part, (str, os.PathLike)) else ("input",)
 
-    def read(path, kept, report):
+    def read(path, kept, report, named):
         return _latvox.read_png(path)
 
     return _run("render", options, meshes=meshes, output="view.png", progress=progress,

@@ -294,7 +294,12 @@ pub struct MeshCollector {
 impl MeshSink for MeshCollector {
     fn begin(&mut self, triangles: Option<u64>) -> Result<()> {
         if let Some(n) = triangles {
+            // A closed mesh has about half as many vertices as triangles.
             self.mesh.indices.reserve(3 * n as usize);
+            self.mesh.positions.reserve(3 * (n as usize / 2 + 2));
+            if self.weld.is_empty() {
+                self.weld = ExactIndex::with_capacity(n as usize / 2 + 2);
+            }
         }
         Ok(())
     }
