@@ -264,6 +264,13 @@ def test_errors_are_exceptions_by_kind(tmp_path):
         latvox.Mesh(np.zeros((4, 2)), np.zeros((1, 3)))
     with pytest.raises(latvox.InputError):
         latvox.check((np.zeros((3, 3)), np.array([[0, 1, 7]])))
+    # A vertex at infinity has no level set (OpenVDB would refuse it: latvox says so first).
+    v, f = box()
+    v[0] = np.inf
+    with pytest.raises(latvox.InputError) as e:
+        latvox.Mesh(v, f).save(tmp_path / "inf.vdb")
+    assert "not finite" in str(e.value)
+    assert not (tmp_path / "inf.vdb").exists()
 
 
 def test_an_output_named_is_written_and_returned(tmp_path):

@@ -201,6 +201,12 @@ impl MeshFile {
                 crate::io::write(mesh, format, self.ascii, w)
             }),
             Written::Vdb => {
+                if mesh.positions.iter().any(|x| !x.is_finite()) {
+                    return Err(Error::invalid(format!(
+                        "{}: a vertex is not finite (NaN or infinite): no level set can be made of the mesh",
+                        self.path.display()
+                    )));
+                }
                 let voxel = self.voxel.or_else(|| mean_edge(mesh)).ok_or_else(|| {
                     Error::invalid(format!(
                         "{}: the part has no triangles to make a level set of",
