@@ -17,7 +17,41 @@ impl<T> Backend<T> for std::result::Result<T, cxx::Exception> {
     fn backend(self, context: &'static str) -> Result<T> {
         self.map_err(|e| Error::Backend {
             context,
-            message: e.what().to_string(),
+            message: message(&e),
         })
     }
+}
+
+/// Longest C++ exception message passed on, in characters.
+const MESSAGE_CHARS: usize = 300;
+
+/// A C++ exception's message as one short line: runs of whitespace and control characters made
+/// one space, at most [`MESSAGE_CHARS`] characters. (OpenVDB's message on a truncated `.vdb`
+/// quotes a name whose length it read from the file: gigabytes of it.)
+pub(crate) fn message(e: &cxx::Exception) -> String {
+    let mut out = String::new();
+    let mut chars = 0;
+    let mut space = false;
+    for (scanned, c) in e.what().chars().enumerate() {
+        if scanned >= 16 * MESSAGE_CHARS {
+            out.push('…');
+            break;
+        }
+        if c.is_whitespace() || c.is_control() {
+            space = !out.is_empty();
+            continue;
+        }
+        if chars >= MESSAGE_CHARS {
+            out.push('…');
+            break;
+        }
+        if space {
+            out.push(' ');
+            chars += 1;
+            space = false;
+        }
+        out.push(c);
+        chars += 1;
+    }
+    out
 }

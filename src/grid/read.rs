@@ -23,7 +23,7 @@ pub fn read_values(path: &Path) -> Result<(Nodes, String)> {
     }
     let mut out = ffi::DenseValues::default();
     ffi::vdb_read_dense(s, MAX_VALUES, &mut out)
-        .map_err(|e| Error::invalid(format!("{}: {}", path.display(), e.what())))?;
+        .map_err(|e| Error::invalid(format!("{}: {}", path.display(), crate::ffi::message(&e))))?;
     let n = [0, 1, 2].map(|a| out.dims[a] as usize);
     let nodes = Nodes {
         origin: [out.origin[0], out.origin[1], out.origin[2]],

@@ -752,6 +752,40 @@ fn bad_fields_are_refused() {
         &["tpms", "--cells", "2", "-r", "8", "-o", "x.stl"],
         &cases,
     );
+    // A .vdb cut short: OpenVDB's message quotes a name whose length it read from the file
+    // (gigabytes); latvox's one line stays short.
+    let whole = std::fs::read(&vectors).unwrap();
+    let cut = dir.path().join("cut.vdb");
+    for part in 1..8 {
+        std::fs::write(&cut, &whole[..whole.len() * part / 8]).unwrap();
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_latvox"))
+            .args([
+                "tpms",
+                "--cells",
+                "2",
+                "-r",
+                "8",
+                "-o",
+                "x.stl",
+                "--density-field",
+            ])
+            .arg(&cut)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "cut at {part}/8");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.starts_with("latvox: ") && err.contains("cut.vdb"),
+            "{err}"
+        );
+        assert!(
+            err.len() < 600 && err.lines().count() == 1,
+            "cut at {part}/8: {} bytes",
+            err.len()
+        );
+    }
+    assert!(!dir.path().join("x.stl").exists());
 }
 
 /// Each case's options after `prefix`, run in `dir`: refused (one line naming the case's
