@@ -36,7 +36,7 @@ void vdb_set_threads(std::size_t threads);
 std::unique_ptr<VdbGrid> vdb_grid_from_leaves(double voxel_size, rust::Slice<const double> origin,
                                               float half_width,
                                               rust::Slice<const int32_t> leaf_origins,
-                                              rust::Slice<const float> values, bool flood_fill,
+                                              rust::Slice<const float> values,
                                               rust::Slice<const int32_t> inside_tiles);
 
 uint64_t vdb_active_voxels(const VdbGrid& grid);

@@ -50,7 +50,6 @@ std::unique_ptr<VdbGrid> vdb_grid_from_leaves(double voxel_size, rust::Slice<con
                                               float half_width,
                                               rust::Slice<const int32_t> leaf_origins,
                                               rust::Slice<const float> values,
-                                              bool flood_fill,
                                               rust::Slice<const int32_t> inside_tiles) {
   using LeafT = openvdb::FloatTree::LeafNodeType;
   vdb_init();
@@ -86,17 +85,14 @@ std::unique_ptr<VdbGrid> vdb_grid_from_leaves(double voxel_size, rust::Slice<con
   });
   auto& tree = grid->tree();
   for (auto* leaf : leaves) tree.addLeaf(leaf);
-  if (flood_fill) {
-    openvdb::tools::signedFloodFill(tree);
-  } else {
-    // The caller knows the inside: the blocks it names are inside, every other unsampled block
-    // outside (the background).
-    for (std::size_t i = 0; i + 2 < inside_tiles.size(); i += 3) {
-      const openvdb::Coord c(inside_tiles[i], inside_tiles[i + 1], inside_tiles[i + 2]);
-      tree.addTile(1, c, -background, false);
-    }
-    tree.prune();
+  // The caller knows the inside: the blocks it names are inside, every other unsampled block
+  // outside (the background). (OpenVDB's signed flood fill from the band gives a whole internal
+  // node with no band in it the sign of its neighbour in key order, which can be wrong.)
+  for (std::size_t i = 0; i + 2 < inside_tiles.size(); i += 3) {
+    const openvdb::Coord c(inside_tiles[i], inside_tiles[i + 1], inside_tiles[i + 2]);
+    tree.addTile(1, c, -background, false);
   }
+  tree.prune();
   return vdb_handle(grid);
 }
 

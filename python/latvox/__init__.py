@@ -23,7 +23,6 @@ import difflib
 import json
 import os
 import tempfile
-from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np

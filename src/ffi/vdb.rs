@@ -60,7 +60,6 @@ pub(crate) mod ffi {
             half_width: f32,
             leaf_origins: &[i32],
             values: &[f32],
-            flood_fill: bool,
             inside_tiles: &[i32],
         ) -> Result<UniquePtr<VdbGrid>>;
         fn vdb_grid_from_mesh(

@@ -30,26 +30,26 @@ impl Grid {
     /// voxels a cell, meshed in tiles of 288, came out with a slab above its box marked inside.)
     pub fn sample_box(field: &dyn Field, spec: GridSpec, region: IndexBox) -> Result<Grid> {
         let inside = |first: [i64; 3]| field.value(spec.point(first)) < 0.0;
-        Self::sample_blocks(field, spec, region, Some(&inside))
+        Self::sample_blocks(field, spec, region, &inside)
     }
 
     /// As [`Grid::sample`], the sign of every block the band does not reach given by `inside`
-    /// (called with a block's first sample) instead of OpenVDB's flood fill from the band: for
-    /// fields whose own inside test is more trustworthy than the band's closure (a scan with
-    /// holes).
+    /// (called with a block's first sample) instead of the field's own sign there: for fields
+    /// whose own inside test is more trustworthy than their value far from the surface (a scan
+    /// with holes).
     pub fn sample_signed(
         field: &dyn Field,
         spec: GridSpec,
         inside: &(dyn Fn([i64; 3]) -> bool + Sync),
     ) -> Result<Grid> {
-        Self::sample_blocks(field, spec, spec.padded_region(), Some(inside))
+        Self::sample_blocks(field, spec, spec.padded_region(), inside)
     }
 
     fn sample_blocks(
         field: &dyn Field,
         spec: GridSpec,
         region: IndexBox,
-        inside: Option<&(dyn Fn([i64; 3]) -> bool + Sync)>,
+        inside: &(dyn Fn([i64; 3]) -> bool + Sync),
     ) -> Result<Grid> {
         let h = spec.voxel;
         let band = spec.half_width * h;
@@ -94,21 +94,18 @@ impl Grid {
                 true
             })
             .collect();
-        let inside_tiles: Vec<i32> = match inside {
-            None => Vec::new(),
-            Some(inside) => {
-                let mut sampled_set = vec![false; total];
-                for (k, &idx) in candidates.iter().enumerate() {
-                    sampled_set[idx] = keep[k];
-                }
-                (0..total)
-                    .into_par_iter()
-                    .filter(|&idx| !sampled_set[idx])
-                    .map(|idx| block_at(lo, n, idx).map(|c| c * 8))
-                    .filter(|first| inside(*first))
-                    .flat_map_iter(|first| (0..3).map(move |a| (first[a] - frame[a]) as i32))
-                    .collect()
+        let inside_tiles: Vec<i32> = {
+            let mut sampled_set = vec![false; total];
+            for (k, &idx) in candidates.iter().enumerate() {
+                sampled_set[idx] = keep[k];
             }
+            (0..total)
+                .into_par_iter()
+                .filter(|&idx| !sampled_set[idx])
+                .map(|idx| block_at(lo, n, idx).map(|c| c * 8))
+                .filter(|first| inside(*first))
+                .flat_map_iter(|first| (0..3).map(move |a| (first[a] - frame[a]) as i32))
+                .collect()
         };
         let mut origins = Vec::with_capacity(candidates.len() * 3);
         let mut w = 0;
@@ -132,7 +129,6 @@ impl Grid {
             spec.half_width as f32,
             &origins,
             &values,
-            inside.is_none(),
             &inside_tiles,
         )
         .backend("building the OpenVDB grid")?;
