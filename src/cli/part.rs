@@ -368,7 +368,7 @@ fn expand_table(
 /// filled part as its meshes and lattice.
 pub(crate) enum Part {
     /// A TPMS or strut part.
-    Block(Model),
+    Block(Box<Model>),
     /// A filled part.
     Filled(Box<Traced>),
 }

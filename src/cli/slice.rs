@@ -7,7 +7,8 @@ use super::part::{is_part_file, part_of, Part};
 use clap::{Args, ValueEnum};
 use latvox::check::CheckOptions;
 use latvox::slice::job::{
-    slice_file, slice_implicit, validate, FolderFormat, Output, SliceOptions, SliceReport,
+    slice_file, slice_implicit, validate, FolderFormat, ImplicitPart, Output, SliceOptions,
+    SliceReport,
 };
 use latvox::slice::plan::Rule;
 use latvox::Result;
@@ -37,7 +38,12 @@ another direction they are two axes across it (stack.json and the JSON report na
 
 A part file (.toml, from `latvox tpms|strut|fill --save-part`) is sliced from its implicit solid:
 the field is sampled on each layer's plane (every --sample mm, only near the surface) and
-contoured by marching squares; nothing is meshed, and a box's sharp cut faces stay sharp.
+contoured by marching squares; nothing is meshed, and a box's sharp cut faces stay sharp. It is
+the same part as the mesh `--part FILE -o part.stl` writes: the same level search on the same
+voxels finds its level (moved by the slivers the mesh's flat facets cut off the curved surface,
+so that it encloses the mesh's volume), and the fragments the box cuts loose, which the mesh
+drops, are dropped from every layer. The report gives the density sliced (sum of area times
+thickness over the box) beside the part's target.
 
 Outputs by name: .cli (CLI v2.0; z of a layer is its top), .svg (one group per layer), .sl1
 (Original Prusa SL1 display, uniform layers only), or a folder (name ending in /, or no
@@ -50,8 +56,10 @@ the layer below (|S_n - S_n-1| / S_n <= C), halving it otherwise, down to --min-
 keeps the stair-step cusp h * |cos(angle between normal and build direction)| under --cusp
 (Dolenc and Makela, Computer-Aided Design 1994).
 
-Exit code 0 when every loop closed; 1 when some chain could not close (the files are written,
-the open chains marked: CLI direction 2, red in SVG); 2 on bad input.";
+Exit code 0 when every loop closed (and a part file's layers hold its density within 0.002);
+1 when some chain could not close (the files are written, the open chains marked: CLI
+direction 2, red in SVG) or a part file's layers miss its density (layers too thick for its
+cells); 2 on bad input.";
 
 /// `latvox slice`.
 pub(crate) const COMMAND: Command = Command {
@@ -74,7 +82,7 @@ impl latvox::batch::Task for SliceArgs {
         let r = execute(self, false, &latvox::progress::Progress::hidden())?;
         Ok(latvox::batch::TaskReport {
             report: serde_json::to_value(&r).map_err(|e| latvox::Error::invalid(e.to_string()))?,
-            passed: r.open_chains == 0,
+            passed: r.passed(),
             warnings: Vec::new(),
         })
     }
@@ -129,7 +137,8 @@ pub struct SliceArgs {
     #[arg(long, value_name = "MM", default_value_t = 0.05, value_parser = super::parse_positive)]
     pub pixel: f64,
     /// Sample spacing on each layer for a part file, mm (default: a quarter of the voxel the
-    /// part would be meshed at, and no coarser than --pixel for masks).
+    /// part is meshed at, or a 192nd of a cell where that is finer; no coarser than --pixel for
+    /// masks).
     #[arg(long, value_name = "MM", value_parser = super::parse_positive)]
     pub sample: Option<f64>,
     /// What a folder output holds.
@@ -214,7 +223,7 @@ pub fn run(a: &SliceArgs, quiet: bool) -> Result<i32> {
     if !super::emit_json(a.report.as_deref(), a.json, &r)? {
         print_summary(&r);
     }
-    Ok(if r.open_chains > 0 { 1 } else { 0 })
+    Ok(if r.passed() { 0 } else { 1 })
 }
 
 /// Slices as `latvox slice` does (the report file written, if asked); `slurm` as for
@@ -241,9 +250,9 @@ pub fn execute(
         .input
         .file_stem()
         .map_or_else(|| "part".into(), |s| s.to_string_lossy().into_owned());
-    let spacing = |voxel: f64| {
+    let spacing = |voxel: f64, cell: f64| {
         a.sample.unwrap_or_else(|| {
-            let h = 0.25 * voxel;
+            let h = 0.25 * latvox::mesh::pipeline::implicit_step(voxel, cell);
             match &opts.output {
                 Some(Output::PngDir { pixel, .. }) => h.min(*pixel),
                 Some(Output::Sl1(_)) => h.min(latvox::slice::masks::SL1_DISPLAY.2),
@@ -254,8 +263,16 @@ pub fn execute(
     let mut r = match part_of(&a.input)? {
         Part::Block(model) => {
             let field = model.field();
-            let h = spacing(model.voxel);
-            let r = slice_implicit(&*field, &model.bounds(), h, &name, &opts, progress)?;
+            let volume = model.bounds().volume();
+            let part = ImplicitPart {
+                field: &*field,
+                bounds: model.bounds(),
+                h: spacing(model.voxel, model.cell),
+                loose: Some((&model.loose, model.voxel)),
+                target: model.target,
+                fraction: &|v| v / volume,
+            };
+            let r = slice_implicit(&part, &name, &opts, progress)?;
             SliceReport {
                 level: Some(model.level),
                 ..r
@@ -264,8 +281,15 @@ pub fn execute(
         Part::Filled(traced) => {
             let lattice = traced.lattice_field();
             let scene = traced.scene(&*lattice, None);
-            let h = spacing(traced.voxel);
-            let r = slice_implicit(&scene, &traced.bounds, h, &name, &opts, progress)?;
+            let part = ImplicitPart {
+                field: &scene,
+                bounds: traced.bounds,
+                h: spacing(traced.voxel, traced.cell),
+                loose: Some((&traced.loose, traced.voxel)),
+                target: Some(traced.density),
+                fraction: &|v| traced.fraction(v),
+            };
+            let r = slice_implicit(&part, &name, &opts, progress)?;
             SliceReport {
                 level: Some(traced.level),
                 ..r
@@ -354,6 +378,19 @@ fn print_summary(r: &SliceReport) {
         None if r.written == (0, r.layers) => {
             outln!("volume    Σ area × thickness {:.4} mm³", r.layer_volume);
         }
+        _ => {}
+    }
+    match (r.density, r.target_density) {
+        (Some(d), Some(t)) => outln!(
+            "density   target {t:.4}  sliced {d:.4}  (error {:+.5}{})",
+            d - t,
+            if r.density_met == Some(false) {
+                ", MISSES the promise of ±0.002"
+            } else {
+                ""
+            }
+        ),
+        (Some(d), None) => outln!("density   sliced {d:.4}"),
         _ => {}
     }
     outln!("wrote     {}", r.outputs.join(", "));

@@ -99,7 +99,11 @@ pub(crate) const COMMAND: Command = Command {
         shared: super::part::LATTICE_BOX,
     }),
     job: Some(job::<TpmsArgs>),
-    trace: Some(|m| Ok(Part::Block(parsed::<TpmsArgs>(m)?.job()?.model()?))),
+    trace: Some(|m| {
+        Ok(Part::Block(Box::new(
+            parsed::<TpmsArgs>(m)?.job()?.model()?,
+        )))
+    }),
     choices: Some(|| {
         serde_json::json!({
             "type": Surface::ALL.map(|s| s.name()),

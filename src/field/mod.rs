@@ -13,6 +13,7 @@ pub mod domain;
 pub mod nodes;
 pub mod periodic;
 pub mod sizing;
+pub mod volume;
 
 pub use domain::Domain;
 

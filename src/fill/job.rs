@@ -139,16 +139,16 @@ impl FillReport {
 }
 
 /// A resolution at which the filled part reaches its density.
-struct Found<F: Family> {
-    voxel: f64,
-    route: Route,
+pub(super) struct Found<F: Family> {
+    pub(super) voxel: f64,
+    pub(super) route: Route,
     /// The pipeline's options, the budget less the distance grid.
-    options: Options,
-    family: FillFamily<F>,
-    best: Measured,
-    tried: Vec<(f64, f64)>,
-    meshing: MeshingStats,
-    grid_bytes: u64,
+    pub(super) options: Options,
+    pub(super) family: FillFamily<F>,
+    pub(super) best: Measured,
+    pub(super) tried: Vec<(f64, f64)>,
+    pub(super) meshing: MeshingStats,
+    pub(super) grid_bytes: u64,
 }
 
 /// The job's part and kept solids, closed, and what closing the part changed.
@@ -320,6 +320,27 @@ impl FillJob {
             return self.run_graded(g, progress, sink);
         }
         let (part, keep, changes) = closed_parts(self, progress)?;
+        self.with_lattice(
+            &part,
+            &keep,
+            progress,
+            Write {
+                changes,
+                start,
+                sink,
+            },
+        )
+    }
+
+    /// Finds the lattice's resolution and level for the closed `part` and `keep` as the mesh
+    /// is made at, and hands them to `then` (which writes the part, or keeps its level).
+    pub(super) fn with_lattice<T: Then>(
+        &self,
+        part: &Mesh,
+        keep: &[Mesh],
+        progress: &Progress,
+        then: T,
+    ) -> Result<T::Out> {
         match &self.lattice {
             Infilling::Tpms { surface, structure } => {
                 let (s, st) = (*surface, *structure);
@@ -341,9 +362,9 @@ impl FillJob {
                         phase,
                     },
                 };
-                self.run_with(
-                    &part, &keep, changes, make, t0, walls, start, progress, sink,
-                )
+                let searched = Instant::now();
+                let found = self.search_with(part, keep, make, t0, walls, progress)?;
+                then.then(self, found, searched, progress)
             }
             Infilling::Strut { cell } => {
                 let model = Arc::new(RadiusModel::new(cell, self.cell));
@@ -370,17 +391,10 @@ impl FillJob {
                     },
                     model: model.clone(),
                 };
-                self.run_with(
-                    &part,
-                    &keep,
-                    changes,
-                    make,
-                    r0,
-                    Some((across, MIN_STRUT_VOXELS, "struts")),
-                    start,
-                    progress,
-                    sink,
-                )
+                let members = Some((across, MIN_STRUT_VOXELS, "struts"));
+                let searched = Instant::now();
+                let found = self.search_with(part, keep, make, r0, members, progress)?;
+                then.then(self, found, searched, progress)
             }
         }
     }
@@ -407,24 +421,20 @@ impl FillJob {
         needs.into_iter().max_by_key(|(n, _)| *n)
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn run_with<F: Family>(
+    /// The resolution search of the part filled with the lattices `make` gives (for a box and
+    /// the cells' corner), from the level `start_level`.
+    fn search_with<F: Family>(
         &self,
         part: &Mesh,
         keep: &[Mesh],
-        changes: Vec<Change>,
         make: impl Fn(Aabb, Vec3) -> F,
         start_level: f64,
         members: Option<(f64, f64, &str)>,
-        start: Instant,
         progress: &Progress,
-        sink: &mut dyn MeshSink,
-    ) -> Result<FillReport>
+    ) -> Result<Resolved<Found<F>>>
     where
         F::Solid: Clone,
     {
-        // The lattice's model (the strut radius model, the TPMS sample table) was made by now.
-        let model_seconds = start.elapsed().as_secs_f64();
         let opts = &self.options;
         let request = resolution::Request {
             part: format!(
@@ -437,7 +447,7 @@ impl FillJob {
             density: Some(self.density),
             auto: self.auto_resolution,
         };
-        let resolved: Resolved<Found<F>> = resolution::search(&request, &mut |r| {
+        resolution::search(&request, &mut |r| {
             let voxel = self.min_cell() / r as f64;
             let shape = {
                 let _p = progress.stage("building the part's distance field");
@@ -483,7 +493,52 @@ impl FillJob {
                 tried: solved.tried,
                 meshing,
             }))
-        })?;
+        })
+    }
+}
+
+/// What is done with the lattice's level once found (the search began at `searched`): the part
+/// written, or its level kept.
+pub(super) trait Then {
+    type Out;
+    fn then<F: Family>(
+        self,
+        job: &FillJob,
+        found: Resolved<Found<F>>,
+        searched: Instant,
+        progress: &Progress,
+    ) -> Result<Self::Out>
+    where
+        F::Solid: Clone;
+}
+
+/// The part written to a sink and reported.
+struct Write<'a> {
+    changes: Vec<Change>,
+    start: Instant,
+    sink: &'a mut dyn MeshSink,
+}
+
+impl Then for Write<'_> {
+    type Out = FillReport;
+
+    fn then<F: Family>(
+        self,
+        job: &FillJob,
+        resolved: Resolved<Found<F>>,
+        searched: Instant,
+        progress: &Progress,
+    ) -> Result<FillReport>
+    where
+        F::Solid: Clone,
+    {
+        let Write {
+            changes,
+            start,
+            sink,
+        } = self;
+        // The lattice's model was made by the time the search began.
+        let model_seconds = searched.duration_since(start).as_secs_f64();
         let Found {
             voxel,
             route,
@@ -510,12 +565,12 @@ impl FillJob {
             },
         );
         let volume = report.volume.unwrap_or(f64::NAN);
-        report.density_against(self.density, family.fraction(volume, &bounds));
+        report.density_against(job.density, family.fraction(volume, &bounds));
         let mut warnings: Vec<String> = resolved.raised.into_iter().collect();
         warnings.append(&mut report.warnings);
         report.warnings = warnings;
         report.timings.total = start.elapsed().as_secs_f64();
-        Ok(self.report(
+        Ok(job.report(
             changes,
             family.part.shape.drains.clone(),
             grid_bytes,

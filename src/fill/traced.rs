@@ -7,15 +7,19 @@
 //! there. Memory is the meshes' and one unit cell's, whatever the number of cells; nothing is
 //! sampled on voxels.
 
-use super::job::{closed, FillJob, Infilling};
+use super::job::{closed_parts, FillJob, Found, Infilling, Then};
 use super::shape::{skin_or_lattice, Drain};
 use crate::error::Result;
 use crate::field::{intersection_clearance, union_clearance, Aabb, Field, Vec3};
 use crate::geom::bvh::Bvh;
 use crate::geom::{norm, sub};
 use crate::grid::GridSpec;
-use crate::lattice::strut::{RadiusModel, StrutLattice};
-use crate::lattice::tpms::{calibrate, Lattice};
+use crate::lattice::strut::StrutLattice;
+use crate::lattice::tpms::Lattice;
+use crate::mesh::pieces::Loose;
+use crate::mesh::pipeline::Family;
+use crate::mesh::resolution::Resolved;
+use crate::progress::Progress;
 use crate::render::camera::{dot, Ray};
 use crate::render::trace::{
     field_normal, field_openness, mesh_hit, sphere_trace, Hit, Scene, Section, Tolerance,
@@ -39,24 +43,29 @@ pub struct Traced {
     pub cell: f64,
     /// The lattice's TPMS level, or its strut radius (mm).
     pub level: f64,
+    /// The density the lattice fills the part to.
+    pub density: f64,
+    /// The fragments the part's mesh drops.
+    pub loose: Loose,
+    /// Volume of the part's skin and kept solids alone, and of the region the lattice fills,
+    /// as the part's meshing measured them, mm³.
+    regions: (f64, f64),
 }
 
 impl FillJob {
     /// The filled part for tracing: the part's and the kept solids' meshes (closed first, as
-    /// for meshing) and the lattice at the level (or radius) its model gives for the density.
+    /// for meshing) and the lattice at the level (or radius) its mesh is written at, found by
+    /// the same search on the same voxels, with the fragments the mesh drops.
     pub fn traced(&self) -> Result<Traced> {
         if self.grading.is_some() {
             return Err(crate::error::Error::invalid(
                 "a graded part is drawn and sliced from its mesh: make it with -o part.stl, then render, view or slice part.stl",
             ));
         }
-        let (part, _) = closed(&self.part, &self.part_name)?;
-        let keep = self
-            .keep
-            .iter()
-            .map(|(name, m)| closed(m, name).map(|(m, _)| Bvh::new(&m)))
-            .collect::<Result<Vec<_>>>()?;
-        let voxel = self.min_cell() / self.resolution as f64;
+        let (part, keep, _) = closed_parts(self, &Progress::hidden())?;
+        let settled = self.with_lattice(&part, &keep, &Progress::hidden(), Settle)?;
+        let keep: Vec<Bvh> = keep.iter().map(Bvh::new).collect();
+        let voxel = settled.voxel;
         let drains = match (self.drain, self.skin > 0.0) {
             (Some(d), true) => {
                 self.check_drain(&part, d)?;
@@ -73,7 +82,7 @@ impl FillJob {
         }
         let (lattice, level) = match &self.lattice {
             Infilling::Tpms { surface, structure } => {
-                let level = calibrate::analytic_level(*surface, *structure, self.density);
+                let level = settled.level;
                 let solid = Lattice {
                     surface: *surface,
                     structure: *structure,
@@ -85,7 +94,7 @@ impl FillJob {
                 (Periodic::Tpms(solid), level)
             }
             Infilling::Strut { cell } => {
-                let radius = RadiusModel::new(cell, self.cell).radius(self.density);
+                let radius = settled.level;
                 let solid = StrutLattice {
                     cell: cell.clone(),
                     size: self.cell,
@@ -108,11 +117,56 @@ impl FillJob {
             voxel,
             cell: self.min_cell(),
             level,
+            density: self.density,
+            loose: settled.loose,
+            regions: settled.regions,
+        })
+    }
+}
+
+/// The level a fill's mesh is written at, and what tracing needs of its meshing.
+struct Settled {
+    level: f64,
+    voxel: f64,
+    loose: Loose,
+    regions: (f64, f64),
+}
+
+/// Keeps the level found.
+struct Settle;
+
+impl Then for Settle {
+    type Out = Settled;
+
+    fn then<F: Family>(
+        self,
+        job: &FillJob,
+        resolved: Resolved<Found<F>>,
+        _: std::time::Instant,
+        _: &Progress,
+    ) -> Result<Settled>
+    where
+        F::Solid: Clone,
+    {
+        use crate::mesh::pipeline::{implicit_level, implicit_step};
+        let f = resolved.found;
+        let step = implicit_step(f.voxel, job.min_cell());
+        Ok(Settled {
+            level: implicit_level(&f.family, &f.best, &f.tried, f.voxel, step),
+            voxel: f.voxel,
+            loose: crate::mesh::pipeline::loose(&f.family, &f.best, f.voxel)?,
+            regions: (f.family.base_volume, f.family.fill_volume),
         })
     }
 }
 
 impl Traced {
+    /// The lattice's share of the region it fills, for a part of `volume` mm³ (the measure
+    /// its mesh's density is given in).
+    pub fn fraction(&self, volume: f64) -> f64 {
+        (volume - self.regions.0) / self.regions.1
+    }
+
     /// The browser editor's scene of the filled part: the lattice inside, the part's surface,
     /// its skin, drains and kept solids.
     pub fn editor_scene(&self) -> EditorScene {

@@ -154,6 +154,8 @@ pub struct Template {
     fragments_by_cell: Vec<(u64, f64)>,
     /// Keys of the vertices of removed fragments.
     fragment_keys: std::collections::HashSet<VertexKey>,
+    /// The removed fragments' shells, standing for their copies in the part.
+    loose: crate::mesh::pieces::Loose,
 }
 
 impl Template {
@@ -176,6 +178,7 @@ impl Template {
         let m = plan.map(|a| a.m as usize);
         let mut fragments_by_cell = vec![(0u64, 0.0f64); m[0] * m[1] * m[2]];
         let mut fragment_keys = std::collections::HashSet::new();
+        let mut loose = crate::mesh::pieces::Loose::default();
         if !keep_fragments {
             let shells = Shells::of(&mesh);
             if shells.kept.iter().any(|&k| !k) {
@@ -199,6 +202,12 @@ impl Template {
                         e.1 += shells.volume[s];
                     }
                 }
+                loose = crate::mesh::pieces::Loose::of_template(
+                    crate::mesh::pieces::loose_triangles(&mesh, &shells),
+                    plan,
+                    tb.min,
+                    cell,
+                );
                 let keep: Vec<bool> = shells
                     .of_vertex
                     .iter()
@@ -210,6 +219,7 @@ impl Template {
         let mut t = Template::from_mesh(mesh, cell, plan)?;
         t.fragments_by_cell = fragments_by_cell;
         t.fragment_keys = fragment_keys;
+        t.loose = loose;
         Ok((t, stats))
     }
 
@@ -258,6 +268,7 @@ impl Template {
             twin,
             fragments_by_cell: Vec::new(),
             fragment_keys: Default::default(),
+            loose: Default::default(),
         })
     }
 
@@ -376,6 +387,49 @@ impl Template {
         total
     }
 
+    /// The sum over the whole part of a quantity each of the template's quads has (one that a
+    /// translation leaves alone): the template's cells stand for every cell of their kind.
+    pub fn part_sum(&self, per_quad: impl Fn(usize) -> f64 + Sync) -> f64 {
+        let per_kind: Vec<f64> = self
+            .quads_by_cell
+            .par_iter()
+            .map(|qs| qs.iter().map(|&q| per_quad(q as usize)).sum())
+            .collect();
+        let mut total = 0.0;
+        self.for_each_kind(|k, count, _| total += count as f64 * per_kind[k]);
+        total
+    }
+
+    /// The template's cells, each with the number of the part's cells it stands for: boxes
+    /// within the template's box (that of the part `part` cut down).
+    pub fn cells_with_counts(&self, part: &Aabb) -> Vec<(Aabb, u64)> {
+        let tb = template_bounds(part, self.cell, &self.plan);
+        let m = self.plan.map(|a| a.m);
+        let mut boxes = vec![tb; (m[0] * m[1] * m[2]) as usize];
+        for i in 0..m[0] {
+            for j in 0..m[1] {
+                for k in 0..m[2] {
+                    let c = [i, j, k];
+                    let b = &mut boxes[self.kind_index(c)];
+                    for a in 0..3 {
+                        if self.plan[a].n > self.plan[a].m {
+                            let lo = tb.min[a] + c[a] as f64 * self.cell[a];
+                            b.min[a] = lo;
+                            b.max[a] = if c[a] == m[a] - 1 {
+                                tb.max[a]
+                            } else {
+                                lo + self.cell[a]
+                            };
+                        }
+                    }
+                }
+            }
+        }
+        let mut out = Vec::with_capacity(boxes.len());
+        self.for_each_kind(|k, count, _| out.push((boxes[k], count)));
+        out
+    }
+
     /// The fragments the box cuts loose in the whole part (removed from the template, so from
     /// every copy).
     pub fn part_fragments(&self) -> Fragments {
@@ -392,6 +446,12 @@ impl Template {
             f.volume += count as f64 * self.fragments_by_cell[k].1;
         });
         f
+    }
+
+    /// The fragments removed from the part (their shells in the template, standing for every
+    /// copy).
+    pub fn loose(&self) -> &crate::mesh::pieces::Loose {
+        &self.loose
     }
 
     /// Whether the vertex of the part with key `key` is a copy of a removed fragment's vertex.

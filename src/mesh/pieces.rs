@@ -8,7 +8,8 @@
 //! the largest volume is the part, and every other outer shell, with the cavities lying within
 //! its bounds, is a fragment.
 
-use crate::field::Aabb;
+use crate::field::{Aabb, Vec3};
+use crate::geom::bvh::Bvh;
 use crate::geom::signed_volume;
 use crate::geom::topology::UnionFind;
 use crate::mesh::extract::KeyedMesh;
@@ -166,20 +167,115 @@ pub fn fragments_of(volume: &[f64], kept: &[bool], removed: bool) -> Fragments {
 }
 
 /// Removes the fragments of `mesh` (every shell not in its largest piece), keeping the order of
-/// the vertices and quads that stay; returns what was removed.
-pub fn remove_fragments(mesh: &mut KeyedMesh) -> Fragments {
+/// the vertices and quads that stay; returns what was removed, and its triangles.
+pub fn remove_fragments(mesh: &mut KeyedMesh) -> (Fragments, Vec<[Vec3; 3]>) {
     let shells = Shells::of(mesh);
     let f = shells.fragments(true);
     if f.count == 0 && shells.kept.iter().all(|&k| k) {
-        return f;
+        return (f, Vec::new());
     }
+    let loose = loose_triangles(mesh, &shells);
     let keep_vertex: Vec<bool> = shells
         .of_vertex
         .iter()
         .map(|&s| s != u32::MAX && shells.kept[s as usize])
         .collect();
     retain(mesh, &keep_vertex);
-    f
+    (f, loose)
+}
+
+/// The triangles of the shells of `mesh` that are not kept (its fragments, their cavities).
+pub fn loose_triangles(mesh: &KeyedMesh, shells: &Shells) -> Vec<[Vec3; 3]> {
+    let mut out = Vec::new();
+    for (i, q) in mesh.quads.iter().enumerate() {
+        let s = shells.of_vertex[q[0] as usize];
+        if s == u32::MAX || shells.kept[s as usize] {
+            continue;
+        }
+        let (t, u) = mesh.quad_triangles(i);
+        for t in std::iter::once(t).chain(u) {
+            out.push(t.map(|v| mesh.positions[v as usize]));
+        }
+    }
+    out
+}
+
+/// The fragments a meshing removed, as closed shells: whether a point of the solid lies in one
+/// (what the implicit routes — slices straight from a part file — need to drop the same
+/// fragments as the mesh). The shells are the whole part's, or a template's, whose cells stand
+/// for the part's as [`crate::mesh::instance::AxisPlan::kind`] says.
+#[derive(Debug, Clone, Default)]
+pub struct Loose {
+    shells: Option<Bvh>,
+    copies: Option<Copies>,
+}
+
+/// How the part's cells map onto a template's: the plan, the cells' lower corner and size.
+#[derive(Debug, Clone, Copy)]
+struct Copies {
+    plan: [crate::mesh::instance::AxisPlan; 3],
+    corner: Vec3,
+    cell: Vec3,
+}
+
+impl Loose {
+    /// The fragments bounded by `triangles` (closed shells, in the part's coordinates).
+    pub fn of(triangles: Vec<[Vec3; 3]>) -> Loose {
+        Loose {
+            shells: (!triangles.is_empty()).then(|| Bvh::over(triangles)),
+            copies: None,
+        }
+    }
+
+    /// The fragments of a template bounded by `triangles`: the part's cell `c` along an axis
+    /// holds what the template's cell `plan[a].kind(c)` holds; cells of size `cell` from
+    /// `corner`.
+    pub fn of_template(
+        triangles: Vec<[Vec3; 3]>,
+        plan: [crate::mesh::instance::AxisPlan; 3],
+        corner: Vec3,
+        cell: Vec3,
+    ) -> Loose {
+        Loose {
+            copies: Some(Copies { plan, corner, cell }),
+            ..Loose::of(triangles)
+        }
+    }
+
+    /// Whether no fragment was removed.
+    pub fn is_empty(&self) -> bool {
+        self.shells.is_none()
+    }
+
+    /// Whether `p` lies inside a removed fragment's shell, or within `reach` of one.
+    pub fn holds(&self, p: Vec3, reach: f64) -> bool {
+        let Some(shells) = &self.shells else {
+            return false;
+        };
+        let q = self.in_shells(p);
+        shells.contains(q) || (reach > 0.0 && shells.distance(q, reach) < reach)
+    }
+
+    /// Whether `p` lies inside a removed fragment's shell.
+    pub fn contains(&self, p: Vec3) -> bool {
+        self.holds(p, 0.0)
+    }
+
+    /// `p` where the shells are: in the template cell that stands for its cell.
+    fn in_shells(&self, p: Vec3) -> Vec3 {
+        let mut q = p;
+        if let Some(c) = &self.copies {
+            for a in 0..3 {
+                let ax = c.plan[a];
+                if ax.n > ax.m {
+                    let i = ((p[a] - c.corner[a]) / c.cell[a]).floor() as i64;
+                    let i = i.clamp(0, ax.n - 1);
+                    q[a] = p[a] - (i - ax.kind(i)) as f64 * c.cell[a];
+                }
+            }
+        }
+        q
+    }
 }
 
 /// Keeps the vertices marked in `keep` and the quads whose corners are all kept, renumbering.

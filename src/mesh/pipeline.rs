@@ -303,6 +303,8 @@ pub struct Measured {
     pub level: f64,
     /// Volume fraction of what will be written.
     pub fraction: f64,
+    /// Volume of what will be written, mm³.
+    pub volume: f64,
     /// What was meshed: the whole part, its template, or nothing held (tiles).
     pub made: Made,
     /// Fragments the box cuts loose.
@@ -312,6 +314,8 @@ pub struct Measured {
     /// Edges of one facet only in what was meshed (the whole part or its template; 0 where
     /// nothing is held): holes that voxels too coarse for the members left.
     pub open_edges: u64,
+    /// The fragments removed, as shells, when the whole part was meshed (see [`loose`]).
+    loose: pieces::Loose,
 }
 
 /// Meshes or measures the solid at `level` on its route.
@@ -337,6 +341,7 @@ pub fn measure_observed<F: Family>(
 ) -> Result<Measured> {
     let solid = family.at(level);
     let template = |plan| Template::build(&solid, voxel, plan, o.keep_fragments);
+    let mut loose = pieces::Loose::default();
     let (made, volume, fragments, meshing) = match route {
         Route::Instanced(plan) | Route::Whole(Some(plan)) | Route::Tiled(_, Some(plan)) => {
             let (t, stats) = template(plan)?;
@@ -355,7 +360,9 @@ pub fn measure_observed<F: Family>(
             let f = if o.keep_fragments {
                 pieces::Shells::of(&mesh).fragments(false)
             } else {
-                pieces::remove_fragments(&mut mesh)
+                let (f, shells) = pieces::remove_fragments(&mut mesh);
+                loose = pieces::Loose::of(shells);
+                f
             };
             let v = keyed_volume(&mesh);
             (Made::Whole(mesh), v, f, stats)
@@ -378,11 +385,125 @@ pub fn measure_observed<F: Family>(
     Ok(Measured {
         level,
         fraction: family.fraction(volume, &solid.bounds()),
+        volume,
         made,
         fragments,
         meshing,
         open_edges,
+        loose,
     })
+}
+
+/// The fragments removed from the part measured in `m` (at its level, on `voxel`), as shells a
+/// point can be tested against: the whole part's, the template's (standing for every copy),
+/// or — for a part measured tile by tile, which held no mesh — each fragment meshed again
+/// within its bounds, two voxels round, its closed shell taken from that small mesh.
+pub fn loose<F: Family>(family: &F, m: &Measured, voxel: f64) -> Result<pieces::Loose> {
+    Ok(match &m.made {
+        Made::Template(t) | Made::Tiles(Some(t)) => t.loose().clone(),
+        Made::TilePieces(found) if !found.loose.is_empty() => {
+            let solid = family.at(m.level);
+            let spec = part_spec(&solid, voxel);
+            let mut triangles = Vec::new();
+            for (_, b) in &found.loose {
+                let index = |x: f64, a: usize| ((x - spec.origin[a]) / voxel).floor() as i64;
+                let region = IndexBox {
+                    lo: [0, 1, 2].map(|a| index(b.min[a], a) - 2),
+                    hi: [0, 1, 2].map(|a| index(b.max[a], a) + 3),
+                };
+                let (mesh, _) = mesh_keyed(&solid, spec, Some(region), 0.0, None)?;
+                let shells = pieces::Shells::of(&mesh);
+                let within = b.grown(0.5 * voxel);
+                let inside = |s: &Aabb| {
+                    (0..3).all(|a| s.min[a] >= within.min[a] && s.max[a] <= within.max[a])
+                };
+                let mut keep = shells.bounds.iter().map(|s| !inside(s)).collect::<Vec<_>>();
+                // The fragment's shells are the small mesh's only ones within its bounds.
+                let shells = pieces::Shells {
+                    kept: std::mem::take(&mut keep),
+                    ..shells
+                };
+                triangles.extend(pieces::loose_triangles(&mesh, &shells));
+            }
+            pieces::Loose::of(triangles)
+        }
+        _ => m.loose.clone(),
+    })
+}
+
+/// The level at which the exact solid (not its mesh) encloses what the part measured in `m`
+/// encloses: the level an implicit route (slices straight from the part, no mesh) takes, so
+/// that it holds the mesh's volume. A mesh whose vertices lie on a curved surface cuts its
+/// chords, and voxels round the sharp edges where the box cuts the lattice: on thin members the
+/// mesh encloses about a percent less than the exact solid at its level, at 32 voxels a cell.
+/// The exact solid's volume is integrated ([`crate::field::volume`], on steps of `step` mm: no
+/// coarser than [`implicit_step`]) over what was meshed — the whole part, or each template cell times the cells it stands for — less
+/// the fragments removed; the level moves by the difference over the solid's growth per level
+/// (the search's last secant, or the family's model), and once more by the secant through the
+/// two exact volumes. The integration holds nothing but its own stack, whatever the part's
+/// size.
+pub fn implicit_level<F: Family>(
+    family: &F,
+    m: &Measured,
+    tried: &[(f64, f64)],
+    voxel: f64,
+    step: f64,
+) -> f64 {
+    let bounds = family.at(m.level).bounds();
+    let boxes: Vec<(Aabb, u64)> = match &m.made {
+        Made::Template(t) | Made::Tiles(Some(t)) => t.cells_with_counts(&bounds),
+        _ => vec![(bounds, 1)],
+    };
+    let removed = if m.fragments.removed {
+        m.fragments.volume
+    } else {
+        0.0
+    };
+    let exact = |level: f64| -> f64 {
+        let solid = family.at(level);
+        let spec = part_spec(&solid, voxel);
+        let field = solid.field(&spec);
+        boxes
+            .iter()
+            .map(|(b, count)| {
+                let clipped = Intersection { a: &*field, b: *b };
+                *count as f64 * crate::field::volume::volume(&clipped, b, step)
+            })
+            .sum::<f64>()
+            - removed
+    };
+    // Fraction per volume, and the solid's growth in volume per level: the search's last
+    // secant where it took two meshings, the model's slope otherwise.
+    let per_volume = family.fraction(1.0, &bounds) - family.fraction(0.0, &bounds);
+    let secant = tried
+        .windows(2)
+        .last()
+        .map(|w| (w[1].1 - w[0].1) / (w[1].0 - w[0].0))
+        .filter(|s| s.is_finite() && *s > 0.0);
+    let slope = secant.unwrap_or_else(|| {
+        let f = family.model_fraction(m.level);
+        let (lo, hi) = ((f - 0.01).max(1e-3), (f + 0.01).min(1.0 - 1e-3));
+        (hi - lo) / (family.model_level(hi) - family.model_level(lo))
+    }) / per_volume;
+    if !(slope.is_finite() && slope > 0.0) {
+        return m.level;
+    }
+    let e0 = exact(m.level) - m.volume;
+    let t1 = m.level - e0 / slope;
+    let e1 = exact(t1) - m.volume;
+    let t2 = t1 - e1 * (t1 - m.level) / (e1 - e0);
+    if t2.is_finite() && e1.abs() > 1e-9 * m.volume.abs() {
+        t2
+    } else {
+        t1
+    }
+}
+
+/// The step [`implicit_level`] integrates on for a part meshed on `voxel` in cells whose shortest
+/// side is `cell`: the voxel, or a 48th of the cell where that is finer (coarse voxels leave
+/// the members a few steps across, where a step's plane is no longer the surface).
+pub fn implicit_step(voxel: f64, cell: f64) -> f64 {
+    voxel.min(cell / 48.0)
 }
 
 /// The volume of `solid` meshed on `route` (whole, or tile by tile without keeping the tiles),
@@ -648,7 +769,7 @@ pub fn write<F: Family>(
             let fragments = if o.keep_fragments {
                 pieces::Shells::of(&mesh).fragments(false)
             } else {
-                pieces::remove_fragments(&mut mesh)
+                pieces::remove_fragments(&mut mesh).0
             };
             write_whole(mesh.into_mesh(), meshing, fragments, o, progress, sink)
         }

@@ -13,15 +13,17 @@ pub mod view;
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
+use crate::mesh::pieces::Loose;
 use crate::mesh::pipeline::Solid;
 use camera::{dot, normalized, Camera};
 use rayon::prelude::*;
 use std::path::Path;
 use trace::{Scene, Tolerance};
 
-/// A part as an implicit solid, at the level its part is meshed at (a TPMS's level calibrated
-/// for the part's own cells and voxel) or its strut radius: what rendering and slicing trace
-/// instead of a mesh. Its field is unclipped; the box clips it.
+/// A part as an implicit solid, at the level (a TPMS's `t`, a strut radius) its mesh is written
+/// at — found by the same search, on the same route and voxels — with the fragments its mesh
+/// drops: what rendering and slicing trace instead of a mesh. Its field is unclipped; the box
+/// clips it.
 pub struct Model {
     /// The lattice (its field unclipped; [`Solid::bounds`] is the clipping box).
     pub lattice: Periodic,
@@ -31,6 +33,10 @@ pub struct Model {
     pub voxel: f64,
     /// The shortest cell side, mm.
     pub cell: f64,
+    /// The volume fraction the part is made to, when it is made to one.
+    pub target: Option<f64>,
+    /// The fragments the box cuts loose, which the mesh drops.
+    pub loose: Loose,
 }
 
 impl Model {

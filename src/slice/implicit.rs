@@ -5,6 +5,10 @@
 //! so the work follows the length of the contours, not the area of the layer. Loops come out
 //! with the solid on the left, like a mesh's sections, and go to the same writers.
 //!
+//! Where the part's meshing dropped fragments the box cuts loose ([`Loose`]), the deepest
+//! sample of each loop's region is tested against the fragments' shells, and the loop is
+//! dropped when it lies in one: the slices hold what the mesh holds.
+//!
 //! The error is marching squares' own — the contour is linear between samples a spacing `h`
 //! apart — and shrinks as h²: nothing is lost at a box's cut faces, where a mesh's sharp edges
 //! are rounded by its voxels.
@@ -12,6 +16,7 @@
 use super::Frame;
 use crate::field::{intersection_clearance, Aabb, Field, Vec3};
 use crate::geom::contour::{iso_loops, Section};
+use crate::mesh::pieces::Loose;
 
 /// Samples per block side.
 const BLOCK: usize = 8;
@@ -29,6 +34,11 @@ pub struct ImplicitSlicer<'a> {
     bounds: [f64; 4],
     /// Sample spacing, mm.
     h: f64,
+    /// Fragments whose loops are dropped.
+    loose: Option<&'a Loose>,
+    /// How far outside a fragment's shell a loop's deepest point may lie and still be the
+    /// fragment's (its voxels round the fragment's thin ends off), mm.
+    reach: f64,
 }
 
 impl<'a> ImplicitSlicer<'a> {
@@ -42,6 +52,18 @@ impl<'a> ImplicitSlicer<'a> {
             frame,
             bounds: b,
             h,
+            loose: None,
+            reach: 0.0,
+        }
+    }
+
+    /// The slicer, dropping the loops of the fragments `loose` holds, meshed on voxels of
+    /// `voxel` mm.
+    pub fn dropping(self, loose: &'a Loose, voxel: f64) -> Self {
+        ImplicitSlicer {
+            loose: (!loose.is_empty()).then_some(loose),
+            reach: voxel,
+            ..self
         }
     }
 
@@ -124,7 +146,14 @@ impl<'a> ImplicitSlicer<'a> {
                 }
             }
         }
-        let loops = iso_loops([nu, nv], |i, j| -vals[j * nu + i], 0.0, -1.0)
+        let mut loops = iso_loops([nu, nv], |i, j| -vals[j * nu + i], 0.0, -1.0);
+        if let Some(loose) = self.loose {
+            loops.retain(|l| {
+                let (i, j) = deepest_in(l, &vals, nu, nv);
+                !loose.holds(at(i as f64, j as f64), self.reach)
+            });
+        }
+        let loops = loops
             .into_iter()
             .map(|l| {
                 l.into_iter()
@@ -137,6 +166,93 @@ impl<'a> ImplicitSlicer<'a> {
             open: Vec::new(),
         }
     }
+}
+
+/// The deepest solid sample of the region a loop (in grid units, on the sample grid's edges)
+/// bounds, within the loop's bounds: the region's samples are reached from the solid end of the
+/// edge the loop's first point is on, through the grid's edges (two solid samples an edge apart
+/// are in one region), and the one farthest (in steps along the grid) from the region's edge is
+/// taken — the middle of a strut's or a wall's section, where a shell meshed on voxels surely
+/// holds it. (The values cannot tell: they are flat where a box's face parallel to the layer
+/// clips them.)
+fn deepest_in(l: &[[f64; 2]], vals: &[f64], nu: usize, nv: usize) -> (usize, usize) {
+    let solid = |i: usize, j: usize| vals[j * nu + i] <= 0.0;
+    let p = l[0];
+    let (a, b) = if p[0].fract() != 0.0 {
+        ((p[0].floor(), p[1]), (p[0].floor() + 1.0, p[1]))
+    } else {
+        ((p[0], p[1].floor()), (p[0], p[1].floor() + 1.0))
+    };
+    let index = |q: (f64, f64)| -> Option<(usize, usize)> {
+        (q.0 >= 0.0 && q.1 >= 0.0 && (q.0 as usize) < nu && (q.1 as usize) < nv)
+            .then_some((q.0 as usize, q.1 as usize))
+            .filter(|&(i, j)| solid(i, j))
+    };
+    let Some(start) = index(a).or_else(|| index(b)) else {
+        return (0, 0);
+    };
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for q in l {
+        lo = [lo[0].min(q[0]), lo[1].min(q[1])];
+        hi = [hi[0].max(q[0]), hi[1].max(q[1])];
+    }
+    let i0 = lo[0].floor().max(0.0) as usize;
+    let j0 = lo[1].floor().max(0.0) as usize;
+    let i1 = (hi[0].ceil() as usize).min(nu - 1);
+    let j1 = (hi[1].ceil() as usize).min(nv - 1);
+    let w = i1 + 1 - i0;
+    let at = |i: usize, j: usize| (j - j0) * w + i - i0;
+    let neighbours = |i: usize, j: usize| {
+        [
+            (i > i0).then(|| (i - 1, j)),
+            (i < i1).then(|| (i + 1, j)),
+            (j > j0).then(|| (i, j - 1)),
+            (j < j1).then(|| (i, j + 1)),
+        ]
+    };
+    // The region, by a flood fill.
+    let mut inside = vec![false; w * (j1 + 1 - j0)];
+    let mut region = vec![start];
+    inside[at(start.0, start.1)] = true;
+    let mut k = 0;
+    while k < region.len() {
+        let (i, j) = region[k];
+        k += 1;
+        for (ni, nj) in neighbours(i, j).into_iter().flatten() {
+            if !inside[at(ni, nj)] && solid(ni, nj) {
+                inside[at(ni, nj)] = true;
+                region.push((ni, nj));
+            }
+        }
+    }
+    // Steps from the region's edge, breadth first from the samples on it.
+    let mut steps = vec![u32::MAX; inside.len()];
+    let mut queue = std::collections::VecDeque::new();
+    for &(i, j) in &region {
+        let edge = neighbours(i, j).iter().filter(|n| n.is_some()).count() < 4
+            || neighbours(i, j)
+                .into_iter()
+                .flatten()
+                .any(|(ni, nj)| !inside[at(ni, nj)]);
+        if edge {
+            steps[at(i, j)] = 0;
+            queue.push_back((i, j));
+        }
+    }
+    let mut best = start;
+    while let Some((i, j)) = queue.pop_front() {
+        let s = steps[at(i, j)];
+        if s > steps[at(best.0, best.1)] {
+            best = (i, j);
+        }
+        for (ni, nj) in neighbours(i, j).into_iter().flatten() {
+            if inside[at(ni, nj)] && steps[at(ni, nj)] == u32::MAX {
+                steps[at(ni, nj)] = s + 1;
+                queue.push_back((ni, nj));
+            }
+        }
+    }
+    best
 }
 
 impl super::plan::Profile for ImplicitSlicer<'_> {

@@ -12,6 +12,8 @@ use crate::error::{Error, Result};
 use crate::field::{Aabb, Field, Vec3};
 use crate::geom::contour::{grow, merge, EMPTY_BOX};
 use crate::geom::Mesh;
+use crate::mesh::pieces::Loose;
+use crate::mesh::pipeline::PROMISE;
 use crate::progress::Progress;
 use crate::verify::{verify, Verify};
 use rayon::prelude::*;
@@ -213,6 +215,13 @@ pub struct SliceReport {
     /// Σ area × thickness over the layers written, mm³ (the whole volume, unsharded: a check of
     /// the slices against the mesh).
     pub layer_volume: f64,
+    /// For a part file: the density of what was sliced (Σ area × thickness, as the part's
+    /// fraction; none for a shard, which slices part of it).
+    pub density: Option<f64>,
+    /// For a part file made to a density: the density.
+    pub target_density: Option<f64>,
+    /// Whether the density sliced is within the promise of the target.
+    pub density_met: Option<bool>,
     /// The files written.
     pub outputs: Vec<String>,
 }
@@ -435,6 +444,12 @@ struct Tally {
 }
 
 impl SliceReport {
+    /// Whether the layers keep the part's promises: every loop closed, and (for a part file
+    /// made to a density) the density sliced within [`PROMISE`] of it.
+    pub fn passed(&self) -> bool {
+        self.open_chains == 0 && self.density_met != Some(false)
+    }
+
     /// The report of `stack` sliced as `opts` asked, with what was found; the mesh's own
     /// figures left empty.
     fn new(stack: &Stack, opts: &SliceOptions, t: Tally) -> SliceReport {
@@ -459,6 +474,9 @@ impl SliceReport {
             level: None,
             mesh_volume: None,
             layer_volume: t.layer_volume,
+            density: None,
+            target_density: None,
+            density_met: None,
             outputs: opts
                 .output
                 .iter()
@@ -535,17 +553,35 @@ fn write_stack(
     Ok(t)
 }
 
-/// Slices an implicit solid — `field` negative inside, nothing outside `bounds` — sampled every
-/// `h` mm on each layer's plane (see [`super::implicit`]), named `name` in the files.
+/// An implicit part to slice: its field, box and sampling, the fragments its mesh drops, and the
+/// density it is made to.
+pub struct ImplicitPart<'a> {
+    /// The solid, negative inside (nothing outside `bounds`).
+    pub field: &'a dyn Field,
+    /// The box that clips it.
+    pub bounds: Aabb,
+    /// Sample spacing on each layer's plane, mm (see [`super::implicit`]).
+    pub h: f64,
+    /// Fragments whose loops are dropped, as the mesh drops them, and the voxel they were
+    /// meshed on (mm).
+    pub loose: Option<(&'a Loose, f64)>,
+    /// The volume fraction the part is made to, if any.
+    pub target: Option<f64>,
+    /// The part's volume fraction from its volume, mm³ (its share of the box, or of the
+    /// region a filled part's lattice fills).
+    pub fraction: &'a (dyn Fn(f64) -> f64 + Sync),
+}
+
+/// Slices an implicit part, named `name` in the files; the report gives the density of what
+/// was sliced (Σ area × thickness, read as the part's fraction) beside the target.
 pub fn slice_implicit(
-    field: &dyn Field,
-    bounds: &Aabb,
-    h: f64,
+    part: &ImplicitPart,
     name: &str,
     opts: &SliceOptions,
     progress: &Progress,
 ) -> Result<SliceReport> {
     validate(opts)?;
+    let (bounds, h) = (&part.bounds, part.h);
     if !(h > 0.0 && h.is_finite()) {
         return Err(Error::invalid(format!(
             "the sample spacing must be a positive length in mm, got {h}"
@@ -558,7 +594,10 @@ pub fn slice_implicit(
     }
     let frame = Frame::new(opts.direction)?;
     let (plane_bounds, heights) = super::implicit::project(bounds, &frame);
-    let slicer = ImplicitSlicer::new(field, bounds, frame, h);
+    let mut slicer = ImplicitSlicer::new(part.field, bounds, frame, h);
+    if let Some((l, voxel)) = part.loose {
+        slicer = slicer.dropping(l, voxel);
+    }
     let n = slicer.samples_per_layer();
     if n > super::implicit::MAX_SAMPLES || n.is_nan() {
         return Err(Error::invalid(format!(
@@ -580,7 +619,15 @@ pub fn slice_implicit(
     let tally = write_stack(&stack, opts, progress, |k| {
         slicer.section(stack.layers[k].z)
     })?;
-    Ok(SliceReport::new(&stack, opts, tally))
+    let mut report = SliceReport::new(&stack, opts, tally);
+    // Only the whole stack measures the part.
+    if report.written == (0, report.layers) {
+        let d = (part.fraction)(report.layer_volume);
+        report.density = Some(d);
+        report.target_density = part.target;
+        report.density_met = part.target.map(|t| (d - t).abs() <= PROMISE);
+    }
+    Ok(report)
 }
 
 /// The part's in-layer bounds, `[u_min, v_min, u_max, v_max]`.

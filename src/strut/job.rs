@@ -196,8 +196,10 @@ impl StrutJob {
         Ok((collector.mesh, report))
     }
 
-    /// The part as an implicit solid at the radius given, or the one the radius model gives for
-    /// the density.
+    /// The part as an implicit solid: the radius given, or the one its mesh is made to the
+    /// density at (the same search, on the same route and voxels) moved by the slivers the
+    /// mesh's chords cut off ([`pipeline::implicit_level`]), so that it encloses the mesh's
+    /// volume; with the fragments the mesh drops.
     pub fn model(&self) -> Result<crate::render::Model> {
         self.validate()?;
         if self.grading.is_some() {
@@ -205,24 +207,25 @@ impl StrutJob {
                 "a graded part is drawn and sliced from its mesh: make it with -o part.stl, then render, view or slice part.stl",
             ));
         }
-        let bounds = self.domain.bounds();
-        let radius = match self.sizing {
-            Sizing::Radius(r) => r,
-            Sizing::Density(d) => RadiusModel::new(&self.cell, self.domain.cell).radius(d),
-        };
+        let (family, _) = self.family();
+        let resolved = self.search(&family, &Progress::hidden())?;
+        let found = &resolved.found;
         let c = self.domain.cell;
+        let step = pipeline::implicit_step(found.voxel, c[0].min(c[1]).min(c[2]));
+        let radius = match self.sizing {
+            // A radius given is the part's radius, whatever its mesh encloses.
+            Sizing::Radius(r) => r,
+            Sizing::Density(_) => {
+                pipeline::implicit_level(&family, &found.best, &found.tried, found.voxel, step)
+            }
+        };
         Ok(crate::render::Model {
             level: radius,
-            lattice: crate::render::Periodic::Struts(StrutLattice {
-                cell: self.cell.clone(),
-                size: c,
-                radius,
-                blend: self.blend,
-                bounds,
-                phase: bounds.min,
-            }),
-            voxel: self.voxel(self.resolution),
+            lattice: crate::render::Periodic::Struts(family.at(radius)),
+            voxel: found.voxel,
             cell: c[0].min(c[1]).min(c[2]),
+            target: self.target(),
+            loose: pipeline::loose(&family, &found.best, found.voxel)?,
         })
     }
 

@@ -7,7 +7,7 @@ use super::{Domain, Lattice, LatticeFamily, Structure, Surface};
 use crate::error::{Error, Result};
 use crate::geom::Mesh;
 use crate::io::sink::{MeshCollector, MeshSink};
-use crate::mesh::pipeline::{self, Options, Route, Solved};
+use crate::mesh::pipeline::{self, Family, Options, Route, Solved};
 use crate::mesh::report::{LevelSearch, PartReport, Timings};
 use crate::mesh::resolution;
 use crate::progress::Progress;
@@ -110,7 +110,10 @@ impl TpmsReport {
 }
 
 impl TpmsJob {
-    /// The part as an implicit solid, at the level the part is meshed at.
+    /// The part as an implicit solid: the level its mesh is written at (the same search, on the
+    /// same route and voxels), moved by the slivers the mesh's chords cut off
+    /// ([`pipeline::implicit_level`]) so that it encloses the mesh's volume, and with the
+    /// fragments the mesh drops.
     pub fn model(&self) -> Result<crate::render::Model> {
         self.validate()?;
         if self.grading.is_some() || self.blend.is_some() || self.cell_map.is_some() {
@@ -118,29 +121,19 @@ impl TpmsJob {
                 "a graded or cell-mapped part is drawn and sliced from its mesh: make it with -o part.stl, then render, view or slice part.stl",
             ));
         }
-        let bounds = self.domain.bounds();
+        let settled = self.settle(&Progress::hidden())?;
+        let found = &settled.resolved.found;
+        let (best, tried) = (&found.solved.best, &found.solved.tried);
         let cell = self.domain.cell;
-        let min_cell = cell[0].min(cell[1]).min(cell[2]);
-        // The level the part is meshed at (calibrated for its partial cells and voxel), so the
-        // model is the solid the mesh approximates; the unit cell's own level if that fails.
-        let (cal, voxel) = self.calibration(self.resolution)?;
-        let level = if cal.converged {
-            cal.level
-        } else {
-            cal.analytic_level
-        };
+        let step = pipeline::implicit_step(found.voxel, cell[0].min(cell[1]).min(cell[2]));
+        let level = pipeline::implicit_level(&found.family, best, tried, found.voxel, step);
         Ok(crate::render::Model {
             level,
-            lattice: crate::render::Periodic::Tpms(Lattice {
-                surface: self.surface,
-                structure: self.structure,
-                level,
-                cell,
-                bounds,
-                phase: bounds.min,
-            }),
-            voxel,
-            cell: min_cell,
+            lattice: crate::render::Periodic::Tpms(found.family.at(level)),
+            voxel: found.voxel,
+            cell: cell[0].min(cell[1]).min(cell[2]),
+            target: Some(self.density),
+            loose: pipeline::loose(&found.family, best, found.voxel)?,
         })
     }
 
@@ -184,26 +177,15 @@ impl TpmsJob {
             return self.run_graded(&g, progress, sink);
         }
         let (s, st) = (self.surface, self.structure);
-        let range = calibrate::feasible(s, st);
-        let (conn, mut warnings) = self.connectivity(range)?;
-        // The first call builds the unit cell's sample table: part of calibrating.
-        let table_start = Instant::now();
-        let t0 = calibrate::analytic_level(s, st, self.density);
-        let table_seconds = table_start.elapsed().as_secs_f64();
-        // Islands asked for are kept: the solid is meant to fall apart.
+        let Settled {
+            t0,
+            range,
+            conn,
+            mut warnings,
+            calibrate_seconds,
+            resolved,
+        } = self.settle(progress)?;
         let opts = self.options(self.instancing, !conn.solid);
-        let mut calibrate_seconds = table_seconds;
-        let request = self.request(format!("the {} {}", s.name(), st.name()), t0);
-        let resolved = resolution::search(&request, &mut |r| {
-            let _p = progress.stage(if r == self.resolution {
-                "calibrating and meshing"
-            } else {
-                "searching for a resolution that reaches the density"
-            });
-            let (cal_seconds, outcome) = self.attempt(r, &opts)?;
-            calibrate_seconds += cal_seconds;
-            Ok(outcome)
-        })?;
         warnings.extend(resolved.raised);
         let Found {
             voxel,
@@ -253,6 +235,40 @@ impl TpmsJob {
             blend: None,
             cell_map: None,
             part,
+        })
+    }
+
+    /// Finds the part's resolution and level as its mesh is made at (every route that shows
+    /// the part — its mesh, its slices, its pictures — takes the level from here).
+    fn settle(&self, progress: &Progress) -> Result<Settled> {
+        let (s, st) = (self.surface, self.structure);
+        let range = calibrate::feasible(s, st);
+        let (conn, warnings) = self.connectivity(range)?;
+        // The first call builds the unit cell's sample table: part of calibrating.
+        let table_start = Instant::now();
+        let t0 = calibrate::analytic_level(s, st, self.density);
+        let table_seconds = table_start.elapsed().as_secs_f64();
+        // Islands asked for are kept: the solid is meant to fall apart.
+        let opts = self.options(self.instancing, !conn.solid);
+        let mut calibrate_seconds = table_seconds;
+        let request = self.request(format!("the {} {}", s.name(), st.name()), t0);
+        let resolved = resolution::search(&request, &mut |r| {
+            let _p = progress.stage(if r == self.resolution {
+                "calibrating and meshing"
+            } else {
+                "searching for a resolution that reaches the density"
+            });
+            let (cal_seconds, outcome) = self.attempt(r, &opts)?;
+            calibrate_seconds += cal_seconds;
+            Ok(outcome)
+        })?;
+        Ok(Settled {
+            t0,
+            range,
+            conn,
+            warnings,
+            calibrate_seconds,
+            resolved,
         })
     }
 
@@ -406,6 +422,16 @@ impl TpmsJob {
             }),
         ))
     }
+}
+
+/// The part's resolution and level, found before anything is written.
+struct Settled {
+    t0: f64,
+    range: FeasibleRange,
+    conn: Connectivity,
+    warnings: Vec<String>,
+    calibrate_seconds: f64,
+    resolved: resolution::Resolved<Found>,
 }
 
 /// A resolution at which the part reaches its density, with the level found.

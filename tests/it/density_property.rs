@@ -18,7 +18,7 @@ use std::path::Path;
 
 /// Where each type and structure holds together (the solid's feasible range, as latvox's
 /// `--help` and refusals state it).
-const FEASIBLE: [(&str, &str, f64, f64); 14] = [
+pub(crate) const FEASIBLE: [(&str, &str, f64, f64); 14] = [
     ("p", "net", 0.2138, 1.0),
     ("p", "sheet", 0.0, 1.0),
     ("gyroid", "net", 0.0191, 1.0),

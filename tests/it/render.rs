@@ -256,6 +256,8 @@ fn sphere_tracing_never_tunnels() {
             level: 0.0,
             voxel,
             cell: 4.0,
+            target: None,
+            loose: Default::default(),
         };
         let field = model.field();
         let bounds = model.bounds();

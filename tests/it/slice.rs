@@ -14,7 +14,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 /// Rows of a slice CSV: z, thickness, area, perimeter, loops, holes.
-fn csv_rows(path: &Path) -> Vec<[f64; 6]> {
+pub(crate) fn csv_rows(path: &Path) -> Vec<[f64; 6]> {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some("z,thickness,area,perimeter,loops,holes"));
@@ -1018,7 +1018,7 @@ fn part_files_slice(all: bool) {
     let cases: [(&str, &str, &Inside, [f64; 3], f64); 3] = [
         ("g", "0.5", &gyroid, [5.3, 3.3, 7.1], 9.0),
         ("b", "0.5", &bcc, [5.0, 5.0, 5.0], 9.0),
-        ("f", "1", &filled, [10.5, 10.25, 10.0], 18.0),
+        ("f", "0.5", &filled, [10.5, 10.25, 10.0], 18.0),
     ];
     for (part, layer, inside, centre, half) in cases {
         // (the main tier slices the gyroid along both directions, the others along +Z)

@@ -132,6 +132,12 @@ pub fn pieces(tris: &[Tri]) -> usize {
 /// outside of a piece, negative for a void it encloses.
 #[allow(dead_code)]
 pub fn shell_volumes(tris: &[Tri]) -> Vec<f64> {
+    shells(tris).iter().map(|s| volume(s)).collect()
+}
+
+/// The shells of a triangle soup: triangles joined through shared corners.
+#[allow(dead_code)]
+pub fn shells(tris: &[Tri]) -> Vec<Vec<Tri>> {
     let key = |p: [f64; 3]| p.map(|x| (x as f32).to_bits());
     let mut id: HashMap<[u32; 3], usize> = HashMap::new();
     let corners: Vec<[usize; 3]> = tris
@@ -157,12 +163,12 @@ pub fn shell_volumes(tris: &[Tri]) -> Vec<f64> {
             parent[a.max(b)] = a.min(b);
         }
     }
-    let mut shell_volume: HashMap<usize, f64> = HashMap::new();
+    let mut shell: HashMap<usize, Vec<Tri>> = HashMap::new();
     for (t, c) in tris.iter().zip(&corners) {
         let r = find(&mut parent, c[0]);
-        *shell_volume.entry(r).or_default() += volume(std::slice::from_ref(t));
+        shell.entry(r).or_default().push(*t);
     }
-    shell_volume.into_values().collect()
+    shell.into_values().collect()
 }
 
 pub fn bounds(tris: &[Tri]) -> ([f64; 3], [f64; 3]) {
