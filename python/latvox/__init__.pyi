@@ -625,7 +625,8 @@ def slice(
     binary: Binary CLI rather than ASCII (.cli output)
     pixel: Pixel size of PNG masks, mm (folder output) (default: 0.05)
     sample: Sample spacing on each layer for a part file, mm (default: a quarter of the voxel the
-        part would be meshed at, and no coarser than --pixel for masks)
+        part is meshed at, or a 192nd of a cell where that is finer; no coarser than --pixel for
+        masks)
     format: What a folder output holds (default: png) [png, svg]
     csv: Per-layer table: z, thickness, area, perimeter, loops, holes
     plot: Plot of layer thickness and area against height (PNG)

@@ -14,7 +14,7 @@ use latvox::{Error, Result};
 pub(crate) type JobOf = fn(&ArgMatches) -> Result<Box<dyn Task>>;
 
 /// Arguments as the part they describe, to trace.
-pub(crate) type TraceOf = fn(&ArgMatches) -> Result<Part>;
+pub(crate) type TraceOf = fn(&ArgMatches, latvox::render::Fidelity) -> Result<Part>;
 
 /// A subcommand.
 pub(crate) struct Command {

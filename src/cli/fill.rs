@@ -73,9 +73,9 @@ pub(crate) const COMMAND: Command = Command {
         shared: super::part::MESHING,
     }),
     job: Some(job::<FillArgs>),
-    trace: Some(|m| {
+    trace: Some(|m, f| {
         Ok(Part::Filled(Box::new(
-            parsed::<FillArgs>(m)?.job()?.traced()?,
+            parsed::<FillArgs>(m)?.job()?.traced(f)?,
         )))
     }),
     choices: Some(|| {

@@ -12,7 +12,7 @@
 use super::clap_message;
 use super::command::{find, names_with, Command};
 use latvox::fill::traced::Traced;
-use latvox::render::Model;
+use latvox::render::{Fidelity, Model};
 use latvox::{Error, Result};
 use std::path::Path;
 
@@ -373,14 +373,14 @@ pub(crate) enum Part {
     Filled(Box<Traced>),
 }
 
-/// A part file's part.
-pub(crate) fn part_of(path: &Path) -> Result<Part> {
-    part_of_table(&read(path)?, path)
+/// A part file's part, modelled for `fidelity`.
+pub(crate) fn part_of(path: &Path, fidelity: Fidelity) -> Result<Part> {
+    part_of_table(&read(path)?, path, fidelity)
 }
 
 /// The part of a part file's `table` (the file at `path`, which files it names are relative
 /// to).
-pub(crate) fn part_of_table(table: &toml::Table, path: &Path) -> Result<Part> {
+pub(crate) fn part_of_table(table: &toml::Table, path: &Path, fidelity: Fidelity) -> Result<Part> {
     let command = table
         .get("command")
         .and_then(toml::Value::as_str)
@@ -395,10 +395,10 @@ pub(crate) fn part_of_table(table: &toml::Table, path: &Path) -> Result<Part> {
             e.prefixed(&name)
         }
     };
-    part_from(&command, table, path).map_err(named)
+    part_from(&command, table, path, fidelity).map_err(named)
 }
 
-fn part_from(command: &str, table: &toml::Table, path: &Path) -> Result<Part> {
+fn part_from(command: &str, table: &toml::Table, path: &Path, fidelity: Fidelity) -> Result<Part> {
     let (command, trace) = match find(command) {
         Some(c @ Command { trace: Some(t), .. }) => (c, *t),
         Some(c) => {
@@ -424,7 +424,7 @@ fn part_from(command: &str, table: &toml::Table, path: &Path) -> Result<Part> {
         .parser()
         .try_get_matches_from(argv)
         .map_err(|e| Error::invalid(clap_message(e)))?;
-    trace(&m)
+    trace(&m, fidelity)
 }
 
 pub(crate) fn is_part_file(path: &Path) -> bool {

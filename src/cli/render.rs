@@ -187,7 +187,7 @@ pub fn run(a: &RenderArgs) -> Result<i32> {
         latvox::io::atomic::check_writable(d)?;
     }
     let (frames, method) = if is_part_file(&a.input) {
-        let frames = match part_of(&a.input)? {
+        let frames = match part_of(&a.input, latvox::render::Fidelity::Look)? {
             Part::Block(model) => {
                 let field = model.field();
                 let scene =

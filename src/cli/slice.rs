@@ -260,7 +260,7 @@ pub fn execute(
             }
         })
     };
-    let mut r = match part_of(&a.input)? {
+    let mut r = match part_of(&a.input, latvox::render::Fidelity::Volume)? {
         Part::Block(model) => {
             let field = model.field();
             let volume = model.bounds().volume();

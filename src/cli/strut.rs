@@ -70,7 +70,7 @@ pub(crate) const COMMAND: Command = Command {
         shared: super::part::LATTICE_BOX,
     }),
     job: Some(job::<StrutArgs>),
-    trace: Some(|m| Ok(Part::Block(Box::new(parsed::<StrutArgs>(m)?.job()?.model()?)))),
+    trace: Some(|m, f| Ok(Part::Block(Box::new(parsed::<StrutArgs>(m)?.job()?.model(f)?)))),
     choices: Some(|| serde_json::json!({ "cell": BUILT_IN })),
     ..Command::new(
         "strut",

@@ -99,9 +99,9 @@ pub(crate) const COMMAND: Command = Command {
         shared: super::part::LATTICE_BOX,
     }),
     job: Some(job::<TpmsArgs>),
-    trace: Some(|m| {
+    trace: Some(|m, f| {
         Ok(Part::Block(Box::new(
-            parsed::<TpmsArgs>(m)?.job()?.model()?,
+            parsed::<TpmsArgs>(m)?.job()?.model(f)?,
         )))
     }),
     choices: Some(|| {

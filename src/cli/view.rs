@@ -88,10 +88,12 @@ pub fn run(a: &ViewArgs) -> Result<i32> {
     let scene_path = path.clone();
     let hooks = Hooks {
         scene: Box::new(move |t| {
-            Ok(match part_of_table(t, &scene_path)? {
-                Part::Block(m) => Scene::of(&m),
-                Part::Filled(traced) => traced.editor_scene(),
-            })
+            Ok(
+                match part_of_table(t, &scene_path, latvox::render::Fidelity::Look)? {
+                    Part::Block(m) => Scene::of(&m),
+                    Part::Filled(traced) => traced.editor_scene(),
+                },
+            )
         }),
         save: Box::new(super::part::write),
     };

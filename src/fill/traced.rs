@@ -55,15 +55,29 @@ pub struct Traced {
 impl FillJob {
     /// The filled part for tracing: the part's and the kept solids' meshes (closed first, as
     /// for meshing) and the lattice at the level (or radius) its mesh is written at, found by
-    /// the same search on the same voxels, with the fragments the mesh drops.
-    pub fn traced(&self) -> Result<Traced> {
+    /// the same search on the same voxels (in tiles beyond [`crate::render::MODEL_MEMORY`]), for
+    /// slices moved so that it encloses the mesh's volume ([`crate::render::Fidelity`]), with
+    /// the fragments the mesh drops.
+    pub fn traced(&self, fidelity: crate::render::Fidelity) -> Result<Traced> {
         if self.grading.is_some() {
             return Err(crate::error::Error::invalid(
                 "a graded part is drawn and sliced from its mesh: make it with -o part.stl, then render, view or slice part.stl",
             ));
         }
         let (part, keep, _) = closed_parts(self, &Progress::hidden())?;
-        let settled = self.with_lattice(&part, &keep, &Progress::hidden(), Settle)?;
+        let bounded = FillJob {
+            options: crate::mesh::pipeline::Options {
+                memory: Some(
+                    self.options
+                        .memory
+                        .unwrap_or(crate::mesh::pipeline::DEFAULT_MEMORY)
+                        .min(crate::render::MODEL_MEMORY),
+                ),
+                ..self.options
+            },
+            ..self.clone()
+        };
+        let settled = bounded.with_lattice(&part, &keep, &Progress::hidden(), Settle(fidelity))?;
         let keep: Vec<Bvh> = keep.iter().map(Bvh::new).collect();
         let voxel = settled.voxel;
         let drains = match (self.drain, self.skin > 0.0) {
@@ -132,8 +146,8 @@ struct Settled {
     regions: (f64, f64),
 }
 
-/// Keeps the level found.
-struct Settle;
+/// Keeps the level found, moved for slices ([`crate::render::Fidelity`]).
+struct Settle(crate::render::Fidelity);
 
 impl Then for Settle {
     type Out = Settled;
@@ -151,8 +165,14 @@ impl Then for Settle {
         use crate::mesh::pipeline::{implicit_level, implicit_step};
         let f = resolved.found;
         let step = implicit_step(f.voxel, job.min_cell());
+        let level = match self.0 {
+            crate::render::Fidelity::Look => f.best.level,
+            crate::render::Fidelity::Volume => {
+                implicit_level(&f.family, &f.best, &f.tried, f.voxel, step)
+            }
+        };
         Ok(Settled {
-            level: implicit_level(&f.family, &f.best, &f.tried, f.voxel, step),
+            level,
             voxel: f.voxel,
             loose: crate::mesh::pipeline::loose(&f.family, &f.best, f.voxel)?,
             regions: (f.family.base_volume, f.family.fill_volume),

@@ -20,6 +20,23 @@ use rayon::prelude::*;
 use std::path::Path;
 use trace::{Scene, Tolerance};
 
+/// What an implicit model of a part is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fidelity {
+    /// Pictures and the editor: the solid at the level its mesh is written at — the surface the
+    /// mesh approximates.
+    Look,
+    /// Slices, which are printed: the level moved so that the exact solid encloses what the
+    /// mesh encloses ([`crate::mesh::pipeline::implicit_level`]; a few micrometres on a lattice
+    /// at 32 voxels a cell), so that the layers hold the part's density.
+    Volume,
+}
+
+/// Memory the level search of an implicit model may use (its part is meshed in tiles beyond
+/// it): the implicit routes exist to show and slice parts too large to mesh whole, and the
+/// level found does not depend on the tiles.
+pub const MODEL_MEMORY: u64 = 512 << 20;
+
 /// A part as an implicit solid, at the level (a TPMS's `t`, a strut radius) its mesh is written
 /// at — found by the same search, on the same route and voxels — with the fragments its mesh
 /// drops: what rendering and slicing trace instead of a mesh. Its field is unclipped; the box

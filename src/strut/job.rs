@@ -197,10 +197,10 @@ impl StrutJob {
     }
 
     /// The part as an implicit solid: the radius given, or the one its mesh is made to the
-    /// density at (the same search, on the same route and voxels) moved by the slivers the
-    /// mesh's chords cut off ([`pipeline::implicit_level`]), so that it encloses the mesh's
-    /// volume; with the fragments the mesh drops.
-    pub fn model(&self) -> Result<crate::render::Model> {
+    /// density at (the same search, on the same voxels; in tiles beyond
+    /// [`crate::render::MODEL_MEMORY`]), for slices moved so that it encloses the mesh's volume
+    /// ([`crate::render::Fidelity`]); with the fragments the mesh drops.
+    pub fn model(&self, fidelity: crate::render::Fidelity) -> Result<crate::render::Model> {
         self.validate()?;
         if self.grading.is_some() {
             return Err(Error::invalid(
@@ -208,13 +208,26 @@ impl StrutJob {
             ));
         }
         let (family, _) = self.family();
-        let resolved = self.search(&family, &Progress::hidden())?;
+        let bounded = StrutJob {
+            options: Options {
+                memory: Some(
+                    self.options
+                        .memory
+                        .unwrap_or(pipeline::DEFAULT_MEMORY)
+                        .min(crate::render::MODEL_MEMORY),
+                ),
+                ..self.options
+            },
+            ..self.clone()
+        };
+        let resolved = bounded.search(&family, &Progress::hidden())?;
         let found = &resolved.found;
         let c = self.domain.cell;
         let step = pipeline::implicit_step(found.voxel, c[0].min(c[1]).min(c[2]));
         let radius = match self.sizing {
             // A radius given is the part's radius, whatever its mesh encloses.
             Sizing::Radius(r) => r,
+            Sizing::Density(_) if fidelity == crate::render::Fidelity::Look => found.best.level,
             Sizing::Density(_) => {
                 pipeline::implicit_level(&family, &found.best, &found.tried, found.voxel, step)
             }

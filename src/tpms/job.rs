@@ -11,6 +11,7 @@ use crate::mesh::pipeline::{self, Family, Options, Route, Solved};
 use crate::mesh::report::{LevelSearch, PartReport, Timings};
 use crate::mesh::resolution;
 use crate::progress::Progress;
+use crate::render::{Fidelity, MODEL_MEMORY};
 use crate::verify::Verdict;
 use std::time::Instant;
 
@@ -111,22 +112,30 @@ impl TpmsReport {
 
 impl TpmsJob {
     /// The part as an implicit solid: the level its mesh is written at (the same search, on the
-    /// same route and voxels), moved by the slivers the mesh's chords cut off
-    /// ([`pipeline::implicit_level`]) so that it encloses the mesh's volume, and with the
-    /// fragments the mesh drops.
-    pub fn model(&self) -> Result<crate::render::Model> {
+    /// same voxels; in tiles beyond [`MODEL_MEMORY`]), for slices moved so that it encloses the
+    /// mesh's volume ([`Fidelity`]), and with the fragments the mesh drops.
+    pub fn model(&self, fidelity: crate::render::Fidelity) -> Result<crate::render::Model> {
         self.validate()?;
         if self.grading.is_some() || self.blend.is_some() || self.cell_map.is_some() {
             return Err(Error::invalid(
                 "a graded or cell-mapped part is drawn and sliced from its mesh: make it with -o part.stl, then render, view or slice part.stl",
             ));
         }
-        let settled = self.settle(&Progress::hidden())?;
+        let bounded = TpmsJob {
+            memory: Some(self.memory.unwrap_or(DEFAULT_MEMORY).min(MODEL_MEMORY)),
+            ..self.clone()
+        };
+        let settled = bounded.settle(&Progress::hidden())?;
         let found = &settled.resolved.found;
         let (best, tried) = (&found.solved.best, &found.solved.tried);
         let cell = self.domain.cell;
         let step = pipeline::implicit_step(found.voxel, cell[0].min(cell[1]).min(cell[2]));
-        let level = pipeline::implicit_level(&found.family, best, tried, found.voxel, step);
+        let level = match fidelity {
+            Fidelity::Look => best.level,
+            Fidelity::Volume => {
+                pipeline::implicit_level(&found.family, best, tried, found.voxel, step)
+            }
+        };
         Ok(crate::render::Model {
             level,
             lattice: crate::render::Periodic::Tpms(found.family.at(level)),

@@ -500,8 +500,9 @@ fn fragments_found_tile_by_tile_are_the_whole_parts() {
         blend: None,
         cell_map: None,
     };
-    let whole = job(None).model().unwrap();
-    let tiled = job(Some(64)).model().unwrap();
+    let volume = latvox::render::Fidelity::Volume;
+    let whole = job(None).model(volume).unwrap();
+    let tiled = job(Some(64)).model(volume).unwrap();
     for m in [&whole, &tiled] {
         for p in &points {
             assert!(m.loose.contains(*p), "{p:?} lies in a fragment");
