@@ -54,10 +54,11 @@ pub struct Traced {
 
 impl FillJob {
     /// The filled part for tracing: the part's and the kept solids' meshes (closed first, as
-    /// for meshing) and the lattice at the level (or radius) its mesh is written at, found by
-    /// the same search on the same voxels (in tiles beyond [`crate::render::MODEL_MEMORY`]), for
-    /// slices moved so that it encloses the mesh's volume ([`crate::render::Fidelity`]), with
-    /// the fragments the mesh drops.
+    /// for meshing) and the lattice: for slices, at the level (or radius) its mesh is written
+    /// at, found by the same search on the same voxels (in tiles beyond
+    /// [`crate::render::MODEL_MEMORY`]) and moved so that it encloses the mesh's volume, with the
+    /// fragments the mesh drops; for pictures, at the level its unit cell gives for the density
+    /// (the part's own search meshes the whole part, whatever its number of cells).
     pub fn traced(&self, fidelity: crate::render::Fidelity) -> Result<Traced> {
         if self.grading.is_some() {
             return Err(crate::error::Error::invalid(
@@ -65,19 +66,26 @@ impl FillJob {
             ));
         }
         let (part, keep, _) = closed_parts(self, &Progress::hidden())?;
-        let bounded = FillJob {
-            options: crate::mesh::pipeline::Options {
-                memory: Some(
-                    self.options
-                        .memory
-                        .unwrap_or(crate::mesh::pipeline::DEFAULT_MEMORY)
-                        .min(crate::render::MODEL_MEMORY),
-                ),
-                ..self.options
-            },
-            ..self.clone()
+        let settled = match fidelity {
+            // The part's own search meshes the whole part, whatever its number of cells: a
+            // picture takes the lattice's level from its unit cell.
+            crate::render::Fidelity::Look => self.unit_cell_level(),
+            crate::render::Fidelity::Volume => {
+                let bounded = FillJob {
+                    options: crate::mesh::pipeline::Options {
+                        memory: Some(
+                            self.options
+                                .memory
+                                .unwrap_or(crate::mesh::pipeline::DEFAULT_MEMORY)
+                                .min(crate::render::MODEL_MEMORY),
+                        ),
+                        ..self.options
+                    },
+                    ..self.clone()
+                };
+                bounded.with_lattice(&part, &keep, &Progress::hidden(), Settle)?
+            }
         };
-        let settled = bounded.with_lattice(&part, &keep, &Progress::hidden(), Settle(fidelity))?;
         let keep: Vec<Bvh> = keep.iter().map(Bvh::new).collect();
         let voxel = settled.voxel;
         let drains = match (self.drain, self.skin > 0.0) {
@@ -138,6 +146,27 @@ impl FillJob {
     }
 }
 
+impl FillJob {
+    /// The lattice's level (or radius) its unit cell's model gives for the density, on the
+    /// voxels the part is meshed at, with no fragments and the regions of a box of lattice.
+    fn unit_cell_level(&self) -> Settled {
+        let level = match &self.lattice {
+            Infilling::Tpms { surface, structure } => {
+                crate::lattice::tpms::calibrate::analytic_level(*surface, *structure, self.density)
+            }
+            Infilling::Strut { cell } => {
+                crate::lattice::strut::RadiusModel::new(cell, self.cell).radius(self.density)
+            }
+        };
+        Settled {
+            level,
+            voxel: self.min_cell() / self.resolution as f64,
+            loose: Loose::default(),
+            regions: (0.0, 1.0),
+        }
+    }
+}
+
 /// The level a fill's mesh is written at, and what tracing needs of its meshing.
 struct Settled {
     level: f64,
@@ -146,8 +175,8 @@ struct Settled {
     regions: (f64, f64),
 }
 
-/// Keeps the level found, moved for slices ([`crate::render::Fidelity`]).
-struct Settle(crate::render::Fidelity);
+/// Keeps the level found, moved for slices ([`crate::render::Fidelity::Volume`]).
+struct Settle;
 
 impl Then for Settle {
     type Out = Settled;
@@ -165,14 +194,8 @@ impl Then for Settle {
         use crate::mesh::pipeline::{implicit_level, implicit_step};
         let f = resolved.found;
         let step = implicit_step(f.voxel, job.min_cell());
-        let level = match self.0 {
-            crate::render::Fidelity::Look => f.best.level,
-            crate::render::Fidelity::Volume => {
-                implicit_level(&f.family, &f.best, &f.tried, f.voxel, step)
-            }
-        };
         Ok(Settled {
-            level,
+            level: implicit_level(&f.family, &f.best, &f.tried, f.voxel, step),
             voxel: f.voxel,
             loose: crate::mesh::pipeline::loose(&f.family, &f.best, f.voxel)?,
             regions: (f.family.base_volume, f.family.fill_volume),
