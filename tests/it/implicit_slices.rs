@@ -24,7 +24,7 @@
 //! runs 6 cases; the long tier (`cargo test --release -- --ignored implicit_slices`) 60.
 
 use crate::common::*;
-use crate::density_property::FEASIBLE;
+use crate::density_property::{round, FEASIBLE};
 use crate::slice::csv_rows;
 use std::path::Path;
 
@@ -49,11 +49,6 @@ struct Case {
     size: [f64; 3],
     origin: [f64; 3],
     resolution: u32,
-}
-
-fn round(x: f64, digits: i32) -> f64 {
-    let m = 10f64.powi(digits);
-    (x * m).round() / m
 }
 
 fn draw(rng: &mut Rng) -> Case {
@@ -354,6 +349,19 @@ fn loops_in_fragments(dir: &Path, part: &str, layer: f64, fragments: &[Vec<Tri>]
     found
 }
 
+/// The shells of an STL that keeps its fragments: the part (the largest) and the fragments (the
+/// other outer shells).
+fn part_and_fragments(stl: &Path) -> (Vec<Tri>, Vec<Vec<Tri>>) {
+    let mut shells = shells(&read_stl(stl));
+    shells.sort_by(|a, b| volume(b).total_cmp(&volume(a)));
+    let fragments = shells.split_off(1);
+    let part = shells.pop().expect("a part");
+    (
+        part,
+        fragments.into_iter().filter(|s| volume(s) > 0.0).collect(),
+    )
+}
+
 #[test]
 fn the_fragments_the_mesh_drops_are_in_no_layer() {
     // A gyroid net at 0.15 in boxes of partial cells, which cut fragments loose: measured whole,
@@ -400,13 +408,7 @@ fn the_fragments_the_mesh_drops_are_in_no_layer() {
             ],
             d,
         );
-        let mut shells = shells(&read_stl(&d.join("k.stl")));
-        shells.sort_by(|a, b| volume(b).total_cmp(&volume(a)));
-        let fragments: Vec<Vec<Tri>> = shells
-            .split_off(1)
-            .into_iter()
-            .filter(|s| volume(s) > 0.0)
-            .collect();
+        let (_, fragments) = part_and_fragments(&d.join("k.stl"));
         assert!(
             !fragments.is_empty(),
             "{size}: the box cuts no fragment loose"
@@ -456,9 +458,7 @@ fn fragments_found_tile_by_tile_are_the_whole_parts() {
         ],
         d,
     );
-    let mut shells = shells(&read_stl(&d.join("k.stl")));
-    shells.sort_by(|a, b| volume(b).total_cmp(&volume(a)));
-    let (part, fragments) = (shells[0].clone(), shells.split_off(1));
+    let (part, fragments) = part_and_fragments(&d.join("k.stl"));
     let inside = |shell: &[Tri]| {
         // A point deep in the shell: the centre of its bounds, moved along a line through it
         // to the middle of the first stretch the shell holds.
