@@ -22,6 +22,7 @@ FUNCTIONS = {
     "fgm": ("", "Mesh"),
     "interpret": ("input: Union[str, os.PathLike, np.ndarray, Density], ", "Mesh"),
     "topopt": ("", "Density"),
+    "homogenize": ("", "Dict[str, Any]"),
     "check": ("mesh: MeshLike, ", "Dict[str, Any]"),
     "repair": ("mesh: MeshLike, ", "Mesh"),
     "slice": ("mesh: MeshLike, ", "List[Layer]"),

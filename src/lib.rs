@@ -63,6 +63,7 @@ pub mod field;
 pub mod fill;
 pub mod geom;
 pub mod grid;
+pub mod homogenize;
 pub mod interpret;
 pub mod io;
 pub mod lattice;

@@ -43,6 +43,7 @@ __all__ = [
     "fill",
     "fgm",
     "topopt",
+    "homogenize",
     "interpret",
     "check",
     "repair",
@@ -450,6 +451,11 @@ def topopt(*, strict: bool = False, progress=None, threads: Optional[int] = None
                 threads=threads, read=read)
 
 
+def homogenize(*, progress=None, threads: Optional[int] = None, **options) -> Dict[str, Any]:
+    return _run("homogenize", options, progress=progress, threads=threads,
+                read=lambda path, kept, report, named: report)
+
+
 def check(mesh: Any, *, strict: bool = False, progress=None, threads: Optional[int] = None,
           **options) -> Dict[str, Any]:
     options["file"] = mesh
@@ -519,6 +525,7 @@ _COMMANDS: Dict[str, Callable[..., Any]] = {
     "fgm": fgm,
     "interpret": interpret,
     "topopt": topopt,
+    "homogenize": homogenize,
     "check": check,
     "repair": repair,
     "slice": slice,
@@ -532,6 +539,7 @@ _CALLS = {
     "fgm": "fgm(**options)",
     "interpret": "interpret(input, **options)",
     "topopt": "topopt(**options)",
+    "homogenize": "homogenize(**options)",
     "check": "check(mesh, **options)",
     "repair": "repair(mesh, **options)",
     "slice": "slice(mesh, **options)",
@@ -545,6 +553,7 @@ _RETURNS = {
     "fgm": "a Mesh (its report as --report writes it)",
     "interpret": "a Mesh (its report as --report writes it)",
     "topopt": "a Density: the densities as an array, and the report",
+    "homogenize": "the report, a dict: stiffness (6 × 6, Voigt order), compliance, constants",
     "check": "the report, a dict (the fields of `latvox check --json`)",
     "repair": "the repaired Mesh (its report as --report writes it)",
     "slice": "a list of Layer: z and the polygons, (K, 2) arrays",

@@ -519,6 +519,58 @@ def topopt(
     """
     ...
 
+def homogenize(
+    *,
+    type: Optional[Value] = None,
+    structure: Optional[Value] = None,
+    side: Optional[Value] = None,
+    cell: Optional[Value] = None,
+    density: Optional[Value] = None,
+    densities: Optional[Value] = None,
+    level: Optional[Value] = None,
+    radius: Optional[Value] = None,
+    cell_size: Optional[Value] = None,
+    voxels: Optional[Value] = None,
+    voxelization: Optional[Value] = None,
+    young: Optional[Value] = None,
+    poisson: Optional[Value] = None,
+    lame: Optional[Value] = None,
+    plot: Optional[Value] = None,
+    report: Optional[Value] = None,
+    strict: bool = False,
+    progress: Progress = None,
+    threads: Optional[int] = None,
+) -> Dict[str, Any]:
+    """
+    The effective elasticity tensor of a lattice's unit cell (numerical homogenisation).
+
+    type: TPMS surface: p, gyroid (g), d, iwp, s, frd, neovius (n), lidinoid (l), split-p (a gyroid
+        when neither --type nor --cell is given)
+    structure: Solid side of the TPMS: net (F ≤ t) or sheet (|F| ≤ t) (default: net)
+    side: Which labyrinth of a net is solid: first (F ≤ t) or other (−F ≤ t) (default: first)
+        [first, other]
+    cell: Strut cell: a built-in name (sc, bcc, bccz, fcc, fccz, octet, kelvin, diamond, rhombic) or
+        a cell file (.json); struts are capsules (sharp joints)
+    density: Relative density, in (0, 1], met on the voxels (0.2 when neither --level nor --radius
+        is given)
+    densities: Densities to tabulate the moduli over, and fit Gibson and Ashby's law E/Es = C·ρⁿ
+        (and G) to: A:B:K (K densities from A to B) or a list D1,D2,…
+    level: The TPMS level t instead of a density
+    radius: The strut radius in mm (times each node's factor) instead of a density
+    cell_size: The cell's size in mm: A or AX,AY,AZ (default: 1)
+    voxels: Voxels along each axis of the cell (default: 40)
+    voxelization: How a voxel weighs: the share of it the solid fills, or 1 where its centre is
+        solid (default: fraction) [fraction, centres]
+    young: The solid's Young's modulus (the tensor comes in its units; 1: relative to the solid)
+        (default: 1)
+    poisson: The solid's Poisson's ratio (default: 0.3)
+    lame: The solid's Lamé constants λ,μ instead of --young and --poisson
+    plot: A picture of the directional Young's modulus (the surface E(d)·d: a sphere for an
+        isotropic cell) from the iso view, the front and the top (PNG)
+    report: JSON report: the settings, the tensor, its inverse, the constants and the solver's work
+    """
+    ...
+
 def check(
     mesh: MeshLike, *,
     report: Optional[Value] = None,

@@ -93,6 +93,18 @@ def test_topopt_to_cad():
     assert t.volume == pytest.approx(d.array.mean() * 30 * 10 * 4.0, rel=0.25)
 
 
+def test_homogenize_gives_the_tensor_and_constants():
+    r = latvox.homogenize(type="gyroid", structure="sheet", density=0.2, voxels=16)
+    c = np.array(r["stiffness"])
+    assert c.shape == (6, 6)
+    assert np.allclose(c, c.T)
+    assert r["relative_density"] == pytest.approx(0.2, abs=1e-4)
+    # Young's modulus along x from the compliance, as the report gives it.
+    assert r["constants"]["young"][0] == pytest.approx(1.0 / np.linalg.inv(c)[0, 0], rel=1e-9)
+    with pytest.raises(latvox.InputError):
+        latvox.homogenize(cell="bcc", level=0.3)
+
+
 def box(size=1.0):
     b = trimesh.creation.box(extents=[size] * 3)
     return np.asarray(b.vertices), np.asarray(b.faces)

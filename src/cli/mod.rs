@@ -7,6 +7,7 @@ pub mod check;
 pub(crate) mod command;
 pub mod fgm;
 pub mod fill;
+pub mod homogenize;
 pub mod interpret;
 pub mod lattice;
 pub(crate) mod out;
@@ -30,6 +31,7 @@ pub(crate) const COMMANDS: &[&command::Command] = &[
     &check::COMMAND,
     &repair::COMMAND,
     &topopt::COMMAND,
+    &homogenize::COMMAND,
     &interpret::COMMAND,
     &fgm::COMMAND,
     &render::COMMAND,

@@ -126,25 +126,25 @@ pub struct StrutArgs {
     pub part_file: PartArgs,
 }
 
-impl StrutArgs {
-    /// The cell the option names: a built-in cell, or else a cell file.
-    fn unit_cell(&self) -> Result<(UnitCell, String)> {
-        let name = self.cell.trim();
-        let lower = name.to_ascii_lowercase();
-        if BUILT_IN.contains(&lower.as_str()) {
-            return Ok((UnitCell::built_in(&lower)?, lower));
-        }
-        let path = Path::new(name);
-        if lower.ends_with(".json") || path.exists() {
-            return Ok((UnitCell::from_file(path)?, name.to_string()));
-        }
-        // Neither: the built-in cell's error, which lists them.
-        Ok((UnitCell::built_in(&lower)?, lower))
+/// The cell `name` names: a built-in cell, or else a cell file; and its name for reports.
+pub(crate) fn unit_cell(name: &str) -> Result<(UnitCell, String)> {
+    let name = name.trim();
+    let lower = name.to_ascii_lowercase();
+    if BUILT_IN.contains(&lower.as_str()) {
+        return Ok((UnitCell::built_in(&lower)?, lower));
     }
+    let path = Path::new(name);
+    if lower.ends_with(".json") || path.exists() {
+        return Ok((UnitCell::from_file(path)?, name.to_string()));
+    }
+    // Neither: the built-in cell's error, which lists them.
+    Ok((UnitCell::built_in(&lower)?, lower))
+}
 
+impl StrutArgs {
     /// The job the options describe.
     pub fn job(&self) -> Result<StrutJob> {
-        let (cell, cell_name) = self.unit_cell()?;
+        let (cell, cell_name) = unit_cell(&self.cell)?;
         let domain = self.domain.domain()?;
         Ok(StrutJob {
             grading: self.grade.grading(&domain.bounds())?,

@@ -33,8 +33,9 @@ pub fn volume(field: &dyn Field, region: &Aabb, h: f64) -> f64 {
     crate::geom::ordered_sum(parts.len(), |i| parts[i])
 }
 
-/// The volume of `b` inside the solid, halving `depth` more times where the surface may cross.
-fn inside(field: &dyn Field, b: &Aabb, depth: u32) -> f64 {
+/// The volume of `b` inside the solid, halving `depth` more times where the surface may cross
+/// (the last halving read off the plane of the eight halves' values).
+pub fn inside(field: &dyn Field, b: &Aabb, depth: u32) -> f64 {
     let c = [0, 1, 2].map(|a| 0.5 * (b.min[a] + b.max[a]));
     let s = b.size();
     let half = 0.5 * (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();

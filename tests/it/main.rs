@@ -21,6 +21,7 @@ mod fill;
 mod formats;
 mod fuzz;
 mod graded;
+mod homogenize;
 mod implicit_slices;
 mod instancing;
 mod interpret;

@@ -35,13 +35,14 @@ const STAGES: [&str; 12] = [
 ];
 
 /// The capabilities: each uses the base and the stages only.
-const CAPABILITIES: [&str; 7] = [
+const CAPABILITIES: [&str; 8] = [
     "tpms",
     "strut",
     "fill",
     "fgm",
     "interpret",
     "topopt",
+    "homogenize",
     "batch",
 ];
 
