@@ -70,6 +70,7 @@ def tpms(
     density: Optional[Value] = None,
     density_grade: Optional[Value] = None,
     density_field: Optional[Value] = None,
+    stiffness_field: Optional[Value] = None,
     clamp: bool = False,
     blend_to: Optional[Value] = None,
     blend_field: Optional[Value] = None,
@@ -117,6 +118,11 @@ def tpms(
         0.1*sin(PI*x/20)"; for fill also d, the depth below the skin), a .npy array of shape (NX,
         NY, NZ) sampled over the box, corners on its corners, or a .vdb's float grid (named density,
         or the first) in the part's coordinates, read between its voxels' centres
+    stiffness_field: Grade by stiffness: a field (as --density-field takes) of the Young's modulus
+        wanted, relative to the solid's (E/Es, the mean along the axes); each point's density is the
+        one at which the lattice's unit cell, homogenised (`latvox homogenize`), is that stiff. With
+        --clamp, stiffnesses beyond those of the densities homogenised (TPMS: 0.05 or the least that
+        holds together to 0.8; struts 0.03 to 0.6) take those densities
     clamp: Hold a density field to the type's feasible range instead of refusing it (reported)
     blend_to: Blend the type into a second one (p, gyroid, d, …) by --blend-field: the solid where
         (1 − w)·F/s + w·F₂/s₂ is below the level (s: each surface's RMS), each cell at its density
@@ -185,6 +191,7 @@ def strut(
     radius: Optional[Value] = None,
     density_grade: Optional[Value] = None,
     density_field: Optional[Value] = None,
+    stiffness_field: Optional[Value] = None,
     clamp: bool = False,
     blend: Optional[Value] = None,
     beams: bool = False,
@@ -225,6 +232,11 @@ def strut(
         0.1*sin(PI*x/20)"; for fill also d, the depth below the skin), a .npy array of shape (NX,
         NY, NZ) sampled over the box, corners on its corners, or a .vdb's float grid (named density,
         or the first) in the part's coordinates, read between its voxels' centres
+    stiffness_field: Grade by stiffness: a field (as --density-field takes) of the Young's modulus
+        wanted, relative to the solid's (E/Es, the mean along the axes); each point's density is the
+        one at which the lattice's unit cell, homogenised (`latvox homogenize`), is that stiff. With
+        --clamp, stiffnesses beyond those of the densities homogenised (TPMS: 0.05 or the least that
+        holds together to 0.8; struts 0.03 to 0.6) take those densities
     clamp: Hold a density field to the type's feasible range instead of refusing it (reported)
     blend: Fillet the joints: smooth minimum over this many mm (0: a sharp union) (default: 0)
     beams: Write the lattice as beams (3MF Beam Lattice extension: each strut a beam with its radii,
@@ -275,6 +287,7 @@ def fill(
     density: Optional[Value] = None,
     density_grade: Optional[Value] = None,
     density_field: Optional[Value] = None,
+    stiffness_field: Optional[Value] = None,
     clamp: bool = False,
     blend: Optional[Value] = None,
     drain: Optional[Value] = None,
@@ -317,6 +330,11 @@ def fill(
         0.1*sin(PI*x/20)"; for fill also d, the depth below the skin), a .npy array of shape (NX,
         NY, NZ) sampled over the box, corners on its corners, or a .vdb's float grid (named density,
         or the first) in the part's coordinates, read between its voxels' centres
+    stiffness_field: Grade by stiffness: a field (as --density-field takes) of the Young's modulus
+        wanted, relative to the solid's (E/Es, the mean along the axes); each point's density is the
+        one at which the lattice's unit cell, homogenised (`latvox homogenize`), is that stiff. With
+        --clamp, stiffnesses beyond those of the densities homogenised (TPMS: 0.05 or the least that
+        holds together to 0.8; struts 0.03 to 0.6) take those densities
     clamp: Hold a density field to the type's feasible range instead of refusing it (reported)
     blend: Fillet the lattice into the skin (and struts at their joints): smooth minimum over this
         many mm (0: a sharp union) (default: 0)
@@ -491,6 +509,7 @@ def topopt(
     max_iterations: Optional[Value] = None,
     element_size: Optional[Value] = None,
     output: Optional[Value] = None,
+    stiffness: Optional[Value] = None,
     log: Optional[Value] = None,
     report: Optional[Value] = None,
     strict: bool = False,
@@ -514,6 +533,10 @@ def topopt(
         1000)
     element_size: Element size in mm, recorded in the report for `latvox interpret`
     output: Output densities (.npy) (default: densities.npy)
+    stiffness: The design's SIMP stiffness relative to the solid (Emin + ρᵖ(1 − Emin)) at the
+        elements' nodes, in the part's coordinates (shape (nelx+1, nely+1, nelz+1), y up, the box
+        nelx·h × nely·h × nelz·h mm): what `tpms`, `strut` and `fill --stiffness-field` read, to
+        print the design as a lattice graded by stiffness
     log: Per-iteration log (CSV: iteration, compliance, volume, change)
     report: JSON report: settings, compliance per iteration, iterations, convergence, time
     """

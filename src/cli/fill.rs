@@ -65,6 +65,7 @@ pub(crate) const COMMAND: Command = Command {
             "density",
             "density-grade",
             "density-field",
+            "stiffness-field",
             "clamp",
             "blend",
             "drain",
@@ -131,7 +132,7 @@ pub struct FillArgs {
     #[arg(long, value_name = "MM[,MM,MM]", default_value = "5", value_parser = parse_positive3, allow_hyphen_values = true)]
     pub cell_size: [f64; 3],
     /// The lattice's volume fraction in the region it fills, in (0, 1).
-    #[arg(long, short = 'd', default_value_t = 0.2, value_parser = parse_density, allow_hyphen_values = true, conflicts_with_all = ["density_grade", "density_field"])]
+    #[arg(long, short = 'd', default_value_t = 0.2, value_parser = parse_density, allow_hyphen_values = true, conflicts_with_all = ["density_grade", "density_field", "stiffness_field"])]
     pub density: f64,
     /// A density that varies through the part: along an axis of its box, or by a field of x, y,
     /// z and d, the depth below the skin in mm (every cell wholly inside the core meets it).
@@ -206,7 +207,17 @@ impl FillArgs {
         let bounds = part
             .bounds()
             .ok_or_else(|| Error::invalid(format!("{part_name}: no triangles")))?;
-        let grading = self.grade.grading(&bounds)?;
+        let grading = self.grade.grading(&bounds, || {
+            Ok(latvox::homogenize::Cell {
+                lattice: match &lattice {
+                    Infilling::Tpms { surface, structure } => {
+                        latvox::homogenize::Lattice::Tpms(*surface, *structure)
+                    }
+                    Infilling::Strut { cell } => latvox::homogenize::Lattice::Strut(cell.clone()),
+                },
+                size: self.cell_size,
+            })
+        })?;
         Ok(FillJob {
             part,
             part_name,

@@ -26,7 +26,7 @@ fn names_file(key: &str, value: &str) -> bool {
     let v = value.to_ascii_lowercase();
     PATHS.contains(&key)
         || (key == "cell" && v.ends_with(".json"))
-        || (key == "density-field" && v.ends_with(".npy"))
+        || ((key == "density-field" || key == "stiffness-field") && v.ends_with(".npy"))
 }
 
 /// Options that may be given several times: saved as lists.
@@ -73,6 +73,10 @@ const EXCLUSIVE: &[[&str; 2]] = &[
     ["radius", "density-grade"],
     ["radius", "density-field"],
     ["density-grade", "density-field"],
+    ["density", "stiffness-field"],
+    ["radius", "stiffness-field"],
+    ["density-grade", "stiffness-field"],
+    ["density-field", "stiffness-field"],
 ];
 
 /// The short forms of long options, to tell whether the command line gave one.

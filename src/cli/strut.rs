@@ -64,6 +64,7 @@ pub(crate) const COMMAND: Command = Command {
             "radius",
             "density-grade",
             "density-field",
+            "stiffness-field",
             "clamp",
             "blend",
         ],
@@ -99,10 +100,10 @@ pub struct StrutArgs {
     pub cell: String,
     /// Target volume fraction of solid, in (0, 1): the strut radius is found for it (0.2 when
     /// neither --density nor --radius is given).
-    #[arg(long, short = 'd', value_parser = parse_density, allow_hyphen_values = true, conflicts_with_all = ["radius", "density_grade", "density_field"])]
+    #[arg(long, short = 'd', value_parser = parse_density, allow_hyphen_values = true, conflicts_with_all = ["radius", "density_grade", "density_field", "stiffness_field"])]
     pub density: Option<f64>,
     /// Strut radius in mm (times each node's factor), instead of a density.
-    #[arg(long, value_name = "MM", value_parser = parse_positive, allow_hyphen_values = true, conflicts_with_all = ["density_grade", "density_field"])]
+    #[arg(long, value_name = "MM", value_parser = parse_positive, allow_hyphen_values = true, conflicts_with_all = ["density_grade", "density_field", "stiffness_field"])]
     pub radius: Option<f64>,
     /// A density that varies through the part (the strut radius varies with it).
     #[command(flatten)]
@@ -145,10 +146,16 @@ impl StrutArgs {
     /// The job the options describe.
     pub fn job(&self) -> Result<StrutJob> {
         let (cell, cell_name) = unit_cell(&self.cell)?;
+        let cell = Arc::new(cell);
         let domain = self.domain.domain()?;
         Ok(StrutJob {
-            grading: self.grade.grading(&domain.bounds())?,
-            cell: Arc::new(cell),
+            grading: self.grade.grading(&domain.bounds(), || {
+                Ok(latvox::homogenize::Cell {
+                    lattice: latvox::homogenize::Lattice::Strut(cell.clone()),
+                    size: domain.cell,
+                })
+            })?,
+            cell,
             cell_name,
             sizing: match (self.radius, self.density) {
                 (Some(r), _) => Sizing::Radius(r),

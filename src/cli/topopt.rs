@@ -22,6 +22,9 @@ Examples:
   # top3d's cantilever, 3D
   latvox topopt --problem cantilever3d --nelx 30 --nely 10 --nelz 4 --volfrac 0.3 -o c3.npy
 
+  # ... and its SIMP stiffness at the nodes, in the part's coordinates (elements of 1 mm here)
+  latvox topopt --problem cantilever3d --nelx 30 --nely 10 --nelz 4 -o c3.npy --stiffness s.npy
+
   # Your own supports and loads
   latvox topopt --problem bracket.toml -o bracket.npy
 
@@ -107,6 +110,12 @@ pub struct TopoptArgs {
         default_value = "densities.npy"
     )]
     pub output: PathBuf,
+    /// The design's SIMP stiffness relative to the solid (Emin + ρᵖ(1 − Emin)) at the elements'
+    /// nodes, in the part's coordinates (shape (nelx+1, nely+1, nelz+1), y up, the box
+    /// nelx·h × nely·h × nelz·h mm): what `tpms`, `strut` and `fill --stiffness-field` read, to
+    /// print the design as a lattice graded by stiffness.
+    #[arg(long, value_name = "FILE.npy")]
+    pub stiffness: Option<PathBuf>,
     /// Per-iteration log (CSV: iteration, compliance, volume, change).
     #[arg(long, value_name = "FILE.csv")]
     pub log: Option<PathBuf>,
@@ -165,7 +174,7 @@ pub fn run(a: &TopoptArgs, quiet: bool) -> Result<i32> {
     let mut s = Settings::new(a.volfrac.unwrap_or(p.volfrac), a.penal, a.rmin, filter);
     s.max_iterations = a.max_iterations;
     latvox::io::atomic::check_writable(&a.output)?;
-    for f in [&a.log, &a.report].into_iter().flatten() {
+    for f in [&a.log, &a.report, &a.stiffness].into_iter().flatten() {
         latvox::io::atomic::check_writable(f)?;
     }
     let progress = latvox::progress::Progress::new(quiet);
@@ -177,6 +186,10 @@ pub fn run(a: &TopoptArgs, quiet: bool) -> Result<i32> {
     })?;
     let (shape, data) = topopt::to_array(&p, &r.densities);
     latvox::io::atomic::write_atomic(&a.output, |w| latvox::io::npy::write(w, &shape, &data))?;
+    if let Some(path) = &a.stiffness {
+        let (shape, data) = topopt::stiffness_at_nodes(&p, &r.densities, s.penal);
+        latvox::io::atomic::write_atomic(path, |w| latvox::io::npy::write(w, &shape, &data))?;
+    }
     if let Some(log) = &a.log {
         latvox::io::atomic::write_atomic(log, |w| {
             writeln!(w, "iteration,compliance,volume,change")?;

@@ -86,6 +86,7 @@ pub(crate) const COMMAND: Command = Command {
             "density",
             "density-grade",
             "density-field",
+            "stiffness-field",
             "clamp",
             "blend-to",
             "blend-field",
@@ -143,7 +144,7 @@ pub struct TpmsArgs {
     #[arg(long, value_name = "first|other", default_value = "first", value_parser = ["first", "other"])]
     pub side: String,
     /// Target volume fraction of solid, in (0, 1).
-    #[arg(long, short = 'd', default_value_t = 0.3, value_parser = parse_density, allow_hyphen_values = true, conflicts_with_all = ["density_grade", "density_field"])]
+    #[arg(long, short = 'd', default_value_t = 0.3, value_parser = parse_density, allow_hyphen_values = true, conflicts_with_all = ["density_grade", "density_field", "stiffness_field"])]
     pub density: f64,
     /// A density that varies through the part.
     #[command(flatten)]
@@ -369,7 +370,6 @@ impl TpmsArgs {
         let cell_map = self.cell_map()?;
         let domain = self.domain()?;
         let bounds = domain.bounds();
-        let grading = self.grade.grading(&bounds)?;
         let structure =
             match (self.structure, self.side.as_str()) {
                 (Structure::Net, "other") => Structure::NetOther,
@@ -378,6 +378,12 @@ impl TpmsArgs {
                 )),
                 (st, _) => st,
             };
+        let grading = self.grade.grading(&bounds, || {
+            Ok(latvox::homogenize::Cell {
+                lattice: latvox::homogenize::Lattice::Tpms(self.surface, structure),
+                size: domain.cell,
+            })
+        })?;
         Ok(TpmsJob {
             surface: self.surface,
             structure,

@@ -50,6 +50,12 @@ enum Kind {
     },
     /// Samples at the nodes of a regular grid whose corners are the box's corners.
     Samples(Nodes),
+    /// Another field's values carried through an increasing table of `(value, density)`.
+    Through {
+        inner: Box<DensityField>,
+        table: Vec<(f64, f64)>,
+        hold: bool,
+    },
 }
 
 impl DensityField {
@@ -163,9 +169,39 @@ impl DensityField {
         }
     }
 
+    /// `inner`'s values carried through `table`, pairs `(value, density)` increasing in both
+    /// (as a lattice's relative stiffness against its density): piecewise linear in the
+    /// logarithms; beyond the table, its end densities where `hold`, else the end pieces' power
+    /// laws (below 0.999); values that are not positive give no density (NaN).
+    pub fn through(
+        inner: DensityField,
+        table: Vec<(f64, f64)>,
+        hold: bool,
+        source: String,
+    ) -> Result<DensityField> {
+        let increasing = table.windows(2).all(|w| w[1].0 > w[0].0 && w[1].1 > w[0].1);
+        if table.len() < 2 || !increasing || table.iter().any(|&(x, y)| !(x > 0.0 && y > 0.0)) {
+            return Err(Error::invalid(
+                "a table from a field to densities needs two or more points, positive and increasing",
+            ));
+        }
+        Ok(DensityField {
+            kind: Kind::Through {
+                inner: Box::new(inner),
+                table,
+                hold,
+            },
+            source,
+        })
+    }
+
     /// Whether the field reads the distance to a part's skin (`d`).
     pub fn uses_distance(&self) -> bool {
-        matches!(&self.kind, Kind::Expr { vars, .. } if vars.contains(&0))
+        match &self.kind {
+            Kind::Expr { vars, .. } => vars.contains(&0),
+            Kind::Through { inner, .. } => inner.uses_distance(),
+            _ => false,
+        }
     }
 
     /// The field at `p`, `d` mm inside the part's skin.
@@ -181,6 +217,27 @@ impl DensityField {
                 expr.eval(&args).unwrap_or(f64::NAN)
             }
             Kind::Samples(nodes) => nodes.at(p),
+            Kind::Through { inner, table, hold } => {
+                let v = inner.at(p, d);
+                if v.is_nan() || v <= 0.0 {
+                    return f64::NAN;
+                }
+                let (first, last) = (table[0], table[table.len() - 1]);
+                if *hold && v <= first.0 {
+                    return first.1;
+                }
+                if *hold && v >= last.0 {
+                    return last.1;
+                }
+                // The piece holding v (the first or last beyond the table's ends).
+                let k = table
+                    .partition_point(|&(x, _)| x <= v)
+                    .clamp(1, table.len() - 1);
+                let ((x0, y0), (x1, y1)) = (table[k - 1], table[k]);
+                let t = (v.ln() - x0.ln()) / (x1.ln() - x0.ln());
+                // A density, below the solid's whatever the law beyond the table says.
+                (y0.ln() + t * (y1.ln() - y0.ln())).exp().min(0.999)
+            }
         }
     }
 }
@@ -428,6 +485,39 @@ mod tests {
 
     fn eval(s: &str, p: Vec3) -> f64 {
         DensityField::parse(s, &unit()).unwrap().at(p, 0.0)
+    }
+
+    /// Through a table of a power law, values come back on the law, inside the table and beyond
+    /// it; values that are not positive give no density.
+    #[test]
+    fn a_table_carries_values_along_its_law() {
+        let law = |x: f64| 0.9 * x.powf(0.5);
+        let table: Vec<(f64, f64)> = [0.01, 0.04, 0.1, 0.3]
+            .iter()
+            .map(|&x| (x, law(x)))
+            .collect();
+        for x in [0.005, 0.02, 0.2, 0.3, 0.5] {
+            let f =
+                DensityField::through(DensityField::constant(x), table.clone(), false, "t".into())
+                    .unwrap();
+            assert!((f.at([0.0; 3], 0.0) - law(x)).abs() < 1e-12, "{x}");
+        }
+        let held =
+            DensityField::through(DensityField::constant(0.5), table.clone(), true, "t".into())
+                .unwrap();
+        assert_eq!(held.at([0.0; 3], 0.0), law(0.3));
+        let f = DensityField::through(
+            DensityField::constant(-0.1),
+            table.clone(),
+            false,
+            "t".into(),
+        )
+        .unwrap();
+        assert!(f.at([0.0; 3], 0.0).is_nan());
+        let falling = vec![(0.1, 0.3), (0.2, 0.2)];
+        assert!(
+            DensityField::through(DensityField::constant(0.1), falling, false, "t".into()).is_err()
+        );
     }
 
     #[test]

@@ -305,3 +305,50 @@ pub fn curve(settings: &Settings, densities: &[f64], progress: &Progress) -> Res
         points,
     })
 }
+
+/// Voxels a side of the cells homogenised for a stiffness table.
+pub const TABLE_VOXELS: usize = 24;
+
+/// The densities that give a lattice each relative stiffness: `(E/Es, ρ)` pairs, increasing,
+/// with Young's modulus the mean of the cell's along its axes (ν = 0.3), homogenised at 9
+/// densities spaced geometrically across the lattice's range (for a TPMS, the densities at which
+/// it holds together) on [`TABLE_VOXELS`] voxels a side.
+pub fn stiffness_table(cell: &Cell, progress: &Progress) -> Result<Vec<(f64, f64)>> {
+    let (lo, hi) = match &cell.lattice {
+        Lattice::Tpms(surface, structure) => {
+            let r = crate::lattice::tpms::calibrate::feasible(*surface, *structure);
+            ((r.min + 0.01).max(0.05), (r.max - 0.01).min(0.8))
+        }
+        Lattice::Strut(_) => (0.03, 0.6),
+    };
+    let k = 9;
+    let densities: Vec<f64> = (0..k)
+        .map(|i| lo * (hi / lo).powf(i as f64 / (k - 1) as f64))
+        .collect();
+    let settings = Settings {
+        cell: cell.clone(),
+        amount: Amount::Density(lo),
+        voxels: [TABLE_VOXELS; 3],
+        voxelization: Voxelization::Fraction,
+        material: Material::from_young(1.0, 0.3)?,
+        tolerance: 1e-8,
+    };
+    let _stage = progress.stage("homogenising the cell for its stiffness at each density");
+    let c = curve(&settings, &densities, &Progress::hidden())?;
+    let table: Vec<(f64, f64)> = c
+        .points
+        .iter()
+        .map(|h| {
+            (
+                h.constants.young.iter().sum::<f64>() / 3.0,
+                h.relative_density,
+            )
+        })
+        .collect();
+    if table.windows(2).any(|w| w[1].0 <= w[0].0) {
+        return Err(Error::invalid(
+            "the cell's stiffness does not rise with its density: it cannot be graded by stiffness",
+        ));
+    }
+    Ok(table)
+}

@@ -231,6 +231,41 @@ pub fn optimise(
     Ok(out)
 }
 
+/// The design's SIMP stiffness relative to the solid, `Emin + ρᵖ(1 − Emin)`, at the nodes of its
+/// elements (each the mean of the elements around it), in a part's coordinates: shape
+/// `(nelx + 1, nely + 1, nelz + 1)` (a 2D design repeated through a thickness of one element),
+/// x along nelx, y up (the optimiser's bottom row at y = 0), z along nelz; the box
+/// `[0, nelx·h] × [0, nely·h] × [0, nelz·h]` with `h` the element size — what a lattice graded by
+/// stiffness reads (`--stiffness-field`).
+pub fn stiffness_at_nodes(p: &Problem, densities: &[f64], penal: f64) -> (Vec<usize>, Vec<f64>) {
+    let (nx, ny, nz) = (p.nelx, p.nely, p.nelz.max(1));
+    let stiffness = |ix: usize, iy: usize, iz: usize| {
+        // The optimiser's rows count down from the top: y up is row ny − 1 − iy.
+        let rho = densities[p.element(ix, ny - 1 - iy, if p.is_3d() { iz } else { 0 })];
+        p.emin + rho.powf(penal) * (1.0 - p.emin)
+    };
+    let mut v = Vec::with_capacity((nx + 1) * (ny + 1) * (nz + 1));
+    for i in 0..=nx {
+        for j in 0..=ny {
+            for k in 0..=nz {
+                let (mut sum, mut count) = (0.0, 0.0);
+                for ex in [i.wrapping_sub(1), i] {
+                    for ey in [j.wrapping_sub(1), j] {
+                        for ez in [k.wrapping_sub(1), k] {
+                            if ex < nx && ey < ny && ez < nz {
+                                sum += stiffness(ex, ey, ez);
+                                count += 1.0;
+                            }
+                        }
+                    }
+                }
+                v.push(sum / count);
+            }
+        }
+    }
+    (vec![nx + 1, ny + 1, nz + 1], v)
+}
+
 /// Densities in the layout of `.npy` files written by optimisers: shape `(nely, nelx)` in 2D or
 /// `(nely, nelx, nelz)` in 3D, C order, row 0 at the top (MATLAB's `xPhys` as NumPy sees it).
 pub fn to_array(p: &Problem, densities: &[f64]) -> (Vec<usize>, Vec<f64>) {

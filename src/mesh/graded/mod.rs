@@ -134,7 +134,8 @@ impl Grading {
             let v = self.field.at(p, d);
             if !(v > 0.0 && v < 1.0) {
                 return Err(Error::invalid(format!(
-                    "the density field is {v} at ({}): densities are volume fractions in (0, 1)",
+                    "the density field ({}) is {v} at ({}): densities are volume fractions in (0, 1)",
+                    self.field.source,
                     point(p)
                 )));
             }
