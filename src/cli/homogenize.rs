@@ -157,14 +157,27 @@ fn parse_lame(s: &str) -> std::result::Result<[f64; 2], String> {
     }
 }
 
+/// A report: the lattice and its cell beside what was computed (one cell or a curve).
 #[derive(serde::Serialize)]
-struct Report<'a> {
+struct Report<T> {
     lattice: String,
     cell_size: [f64; 3],
     parameter_name: &'static str,
     voigt_order: &'static str,
     #[serde(flatten)]
-    result: &'a Homogenized,
+    result: T,
+}
+
+impl<T> Report<T> {
+    fn of(name: &str, a: &HomogenizeArgs, settings: &Settings, result: T) -> Report<T> {
+        Report {
+            lattice: name.to_string(),
+            cell_size: a.cell_size,
+            parameter_name: settings.cell.lattice.parameter(),
+            voigt_order: "xx, yy, zz, yz, xz, xy (engineering shears)",
+            result,
+        }
+    }
 }
 
 impl HomogenizeArgs {
@@ -227,16 +240,6 @@ impl HomogenizeArgs {
     }
 }
 
-#[derive(serde::Serialize)]
-struct CurveReport<'a> {
-    lattice: String,
-    cell_size: [f64; 3],
-    parameter_name: &'static str,
-    voigt_order: &'static str,
-    #[serde(flatten)]
-    curve: &'a homogenize::Curve,
-}
-
 pub fn run(a: &HomogenizeArgs, quiet: bool) -> Result<i32> {
     let (settings, name) = a.settings()?;
     for f in [&a.report, &a.plot].into_iter().flatten() {
@@ -245,14 +248,11 @@ pub fn run(a: &HomogenizeArgs, quiet: bool) -> Result<i32> {
     let progress = latvox::progress::Progress::new(quiet || a.json);
     if let Some(Densities(densities)) = &a.densities {
         let curve = homogenize::curve(&settings, densities, &progress)?;
-        let report = CurveReport {
-            lattice: name.clone(),
-            cell_size: a.cell_size,
-            parameter_name: settings.cell.lattice.parameter(),
-            voigt_order: "xx, yy, zz, yz, xz, xy (engineering shears)",
-            curve: &curve,
-        };
-        if !emit_json(a.report.as_deref(), a.json, &report)? {
+        if !emit_json(
+            a.report.as_deref(),
+            a.json,
+            &Report::of(&name, a, &settings, &curve),
+        )? {
             print_curve(&name, &settings, &curve);
         }
         return Ok(0);
@@ -261,14 +261,11 @@ pub fn run(a: &HomogenizeArgs, quiet: bool) -> Result<i32> {
     if let Some(p) = &a.plot {
         homogenize::picture::write_picture(&h.compliance, p, 400)?;
     }
-    let report = Report {
-        lattice: name.clone(),
-        cell_size: a.cell_size,
-        parameter_name: settings.cell.lattice.parameter(),
-        voigt_order: "xx, yy, zz, yz, xz, xy (engineering shears)",
-        result: &h,
-    };
-    if emit_json(a.report.as_deref(), a.json, &report)? {
+    if emit_json(
+        a.report.as_deref(),
+        a.json,
+        &Report::of(&name, a, &settings, &h),
+    )? {
         return Ok(0);
     }
     print_summary(&name, &settings, &h);

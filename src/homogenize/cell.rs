@@ -145,7 +145,7 @@ impl Cell {
         };
         let mean = |w: &[f64]| w.iter().sum::<f64>() / voxels;
         let mut a = self.first_guess(density);
-        let mut wa = self.weights(a, n, rule);
+        let wa = self.weights(a, n, rule);
         let mut fa = mean(&wa) - density;
         if fa.abs() <= tol {
             return Ok((a, wa));
@@ -189,10 +189,9 @@ impl Cell {
                 (None, Some(_)) => next = next.min(b - 0.1 * scale).max(b - 4.0 * scale),
                 (None, None) => unreachable!(),
             }
-            (a, fa, wa) = (b, fb, wb);
+            (a, fa) = (b, fb);
             b = next;
         }
-        let _ = wa;
         Err(Error::invalid(format!(
             "no {} gives a voxelised density of {density} on {}×{}×{} voxels",
             self.lattice.parameter(),

@@ -37,6 +37,8 @@ struct Level {
     w: Vec<f64>,
     /// Whether a solid voxel touches the node.
     active: Vec<bool>,
+    /// How many nodes are active.
+    active_count: usize,
     /// Inverse of the operator's diagonal (0 on inactive nodes), 3 per node.
     inv_diag: Vec<f64>,
 }
@@ -74,6 +76,7 @@ impl Level {
             ke,
             w,
             active: vec![false; nodes],
+            active_count: 0,
             inv_diag: vec![0.0; 3 * nodes],
         };
         let (active, inv_diag): (Vec<bool>, Vec<[f64; 3]>) = (0..nodes)
@@ -93,6 +96,7 @@ impl Level {
                 (any, if any { d.map(|d| 1.0 / d) } else { [0.0; 3] })
             })
             .unzip();
+        level.active_count = active.iter().filter(|&&a| a).count();
         level.active = active;
         level.inv_diag = inv_diag.into_iter().flatten().collect();
         level
@@ -334,7 +338,7 @@ impl Solver {
 
     /// Unknowns of the finest grid.
     pub fn unknowns(&self) -> usize {
-        3 * self.levels[0].active.iter().filter(|&&a| a).count()
+        3 * self.levels[0].active_count
     }
 
     /// The preconditioner: one V-cycle from level `l` on the residual `r`.
@@ -377,7 +381,7 @@ impl Solver {
     /// Removes the rigid translation from `x`: the mean of each component over the active nodes.
     fn project(&self, x: &mut [f64]) {
         let lev = &self.levels[0];
-        let count = lev.active.iter().filter(|&&a| a).count().max(1) as f64;
+        let count = lev.active_count.max(1) as f64;
         let mut mean = [0.0; 3];
         for (p, a) in lev.active.iter().enumerate() {
             if *a {
