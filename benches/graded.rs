@@ -41,6 +41,7 @@ fn one(config: &str) {
         domain,
         resolution: 32,
         adaptivity: 0.0,
+        tolerance: None,
         allow_islands: false,
         auto_resolution: true,
         verify: latvox::verify::Verify::Full,

@@ -208,6 +208,7 @@ fn child(a: &[String]) {
                 domain,
                 resolution: res,
                 adaptivity: 0.0,
+                tolerance: None,
                 allow_islands: false,
                 auto_resolution: true,
                 verify: latvox::verify::Verify::Full,

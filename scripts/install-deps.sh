@@ -78,9 +78,10 @@ fi
 # through the browser editor's page; it uses that browser and downloads none of its own), libigl
 # (the peer of the FGM benchmark: its fast winding numbers for point clouds), and manifold3d
 # (cuts a graded part at its cells' faces to measure each cell's density); maturin, pytest and
-# tqdm build and test the Python package (python/).
-PY_PKGS=(numpy scipy gmsh ezdxf trimesh networkx lxml lib3mf shapely playwright libigl manifold3d maturin pytest tqdm)
-PY_IMPORTS="import numpy, scipy, gmsh, ezdxf, trimesh, networkx, lxml, lib3mf, shapely, playwright, igl, manifold3d, maturin, pytest, tqdm"
+# tqdm build and test the Python package (python/); fast-simplification (the mesh-only
+# decimator beside `--tolerance` in its benchmark).
+PY_PKGS=(numpy scipy gmsh ezdxf trimesh networkx lxml lib3mf shapely playwright libigl manifold3d maturin pytest tqdm fast-simplification)
+PY_IMPORTS="import numpy, scipy, gmsh, ezdxf, trimesh, networkx, lxml, lib3mf, shapely, playwright, igl, manifold3d, maturin, pytest, tqdm, fast_simplification"
 if python3 -c "$PY_IMPORTS" 2>/dev/null; then
   echo "install-deps: Python packages present" >&2
 else

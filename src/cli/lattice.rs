@@ -3,8 +3,8 @@
 
 use super::out::outln;
 use super::{
-    cgal_findings, parse_counts, parse_finite3, parse_positive3, parse_size, parse_tile,
-    parse_unit, write_json,
+    cgal_findings, parse_counts, parse_finite3, parse_positive, parse_positive3, parse_size,
+    parse_tile, parse_unit, write_json,
 };
 use clap::Args;
 use latvox::field::density::DensityField;
@@ -194,6 +194,16 @@ pub struct MeshArgs {
     /// OpenVDB mesh adaptivity: 0 keeps uniform triangles, up to 1 merges flat regions.
     #[arg(long, default_value_t = 0.0, value_parser = parse_unit)]
     pub adaptivity: f64,
+    /// Simplify the mesh: the largest distance allowed between it and the exact surface, mm.
+    /// Flat regions get large triangles, curved ones small; every vertex stays on the surface,
+    /// the density is kept, and the deviation is measured and reported. Without it the mesh is
+    /// uniform (two triangles per voxel the surface crosses): its deviation is about half a
+    /// voxel at the box's cut edges and where struts meet, so half a voxel
+    /// (cell / resolution / 2, 0.078 mm for 5 mm cells at 32) keeps that deviation with 10–30×
+    /// fewer triangles. A smaller one meshes the part on voxels up to half as large first. The part is then
+    /// meshed whole (not copied cell by cell, nor in tiles).
+    #[arg(long, value_name = "MM", value_parser = parse_positive, allow_hyphen_values = true)]
+    pub tolerance: Option<f64>,
     /// Output mesh, in the format its extension names: .stl (binary, ASCII with --ascii) or
     /// .3mf, streamed to the file as it is made; .obj, .off or .ply (binary, ASCII with
     /// --ascii), written once the part is whole; .vdb, the part's level set at its voxels
@@ -242,6 +252,7 @@ impl MeshArgs {
     pub fn options(&self) -> Options {
         Options {
             adaptivity: self.adaptivity,
+            tolerance: self.tolerance,
             verify: if self.no_self_intersection_check && self.verify == Verify::Full {
                 Verify::Fast
             } else {
@@ -328,6 +339,24 @@ pub(crate) fn print_part(r: &PartReport) {
             b.max[0],
             b.max[1],
             b.max[2]
+        );
+    }
+    if let Some(s) = &r.simplified {
+        let st = &s.stats;
+        outln!(
+            "simplified {} of the uniform mesh's {} triangles ({:.1}× fewer); deviation {:.4} mm measured, tolerance {} mm{}",
+            st.triangles_after,
+            s.uniform_triangles,
+            s.uniform_triangles as f64 / st.triangles_after.max(1) as f64,
+            s.deviation,
+            st.tolerance,
+            if st.gave_up {
+                " (crossings remained: the uniform mesh was written)".to_string()
+            } else if s.voxel < r.meshing.voxel_size {
+                format!(" (meshed on {:.4} mm voxels first)", s.voxel)
+            } else {
+                String::new()
+            }
         );
     }
     let f = &r.fragments;

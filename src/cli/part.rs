@@ -53,6 +53,7 @@ pub(crate) const LATTICE_BOX: &[&str] = &[
     "resolution",
     "fixed-resolution",
     "adaptivity",
+    "tolerance",
     "keep-fragments",
 ];
 
@@ -61,6 +62,7 @@ pub(crate) const MESHING: &[&str] = &[
     "resolution",
     "fixed-resolution",
     "adaptivity",
+    "tolerance",
     "keep-fragments",
 ];
 

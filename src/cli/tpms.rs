@@ -391,6 +391,7 @@ impl TpmsArgs {
             domain,
             resolution: m.resolution,
             adaptivity: o.adaptivity,
+            tolerance: o.tolerance,
             allow_islands: self.allow_islands,
             auto_resolution: !m.fixed_resolution,
             verify: o.verify,

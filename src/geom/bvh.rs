@@ -315,7 +315,7 @@ fn box_distance2(b: &Aabb, p: Vec3) -> f64 {
 }
 
 /// The squared distance from `p` to the triangle (Ericson, Real-Time Collision Detection 5.1.5).
-fn triangle_distance2(p: Vec3, t: &[Vec3; 3]) -> f64 {
+pub(crate) fn triangle_distance2(p: Vec3, t: &[Vec3; 3]) -> f64 {
     let [a, b, c] = *t;
     let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
     let (d1, d2) = (dot(ab, ap), dot(ac, ap));

@@ -20,5 +20,6 @@ pub mod pieces;
 pub mod pipeline;
 pub mod report;
 pub mod resolution;
+pub mod simplify;
 pub mod snap;
 pub mod tile;

@@ -29,6 +29,7 @@ use crate::io::sink::{Measures, MeshSink, Triangle};
 use crate::mesh::extract::KeyedMesh;
 use crate::mesh::instance::{self, AxisPlan, Template};
 use crate::mesh::pieces::{self, Fragments};
+use crate::mesh::simplify::{self, SimplifyStats, Surface};
 use crate::mesh::snap::SnapStats;
 use crate::mesh::tile;
 use crate::progress::Progress;
@@ -199,6 +200,10 @@ pub fn part_spec<S: Solid + ?Sized>(solid: &S, voxel: f64) -> GridSpec {
 pub struct Options {
     /// OpenVDB volumeToMesh adaptivity, 0 (uniform) to 1; above 0 the part is meshed whole.
     pub adaptivity: f64,
+    /// Simplify the mesh within this distance of the exact surface, mm (see
+    /// [`crate::mesh::simplify`]); the part is then meshed whole and its density measured on
+    /// the simplified mesh.
+    pub tolerance: Option<f64>,
     /// How the written part is verified.
     pub verify: Verify,
     /// Copy a periodic part's cells from a meshed template where possible.
@@ -234,7 +239,7 @@ impl Route {
         if o.adaptivity != 0.0 {
             return Route::Whole(None);
         }
-        if o.instancing && o.tile.is_none() {
+        if o.instancing && o.tile.is_none() && o.tolerance.is_none() {
             if let Some(p) = plan(instance::plan) {
                 return Route::Instanced(p);
             }
@@ -273,6 +278,10 @@ impl Route {
             let cell = solid.period().expect("a plan needs a period");
             part >= 4 * template && fits(&instance::template_bounds(&bounds, cell, p))
         });
+        if o.tolerance.is_some() {
+            // Simplified whole (copies and tiles would need their seams held).
+            return Route::Whole(measuring);
+        }
         match o.tile {
             Some(edge) => Route::Tiled(edge, measuring),
             None if !fits(&bounds) => {
@@ -709,6 +718,8 @@ pub struct Written {
     pub instancing: Option<Instancing>,
     /// Set when the part was meshed in tiles.
     pub tiling: Option<Tiling>,
+    /// Set when the mesh was simplified within a tolerance.
+    pub simplified: Option<Simplified>,
     /// Time of CGAL's checks, seconds.
     pub verify_seconds: f64,
     /// Time of writing, seconds.
@@ -727,6 +738,24 @@ pub struct Instancing {
     /// The checks ran on the template, which holds every kind of cell the part has; the part is
     /// written as exact copies of its cells.
     pub verified: &'static str,
+}
+
+/// How the mesh was simplified, and how far it lies from the exact surface.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Simplified {
+    /// What simplification did.
+    #[serde(flatten)]
+    pub stats: SimplifyStats,
+    /// The largest distance from points sampled on the written mesh (a quarter voxel apart) to
+    /// the exact surface, mm.
+    pub deviation: f64,
+    /// The voxel the simplified mesh was made on, mm: finer than the part's where its uniform
+    /// mesh strayed further than the tolerance.
+    pub voxel: f64,
+    /// The largest deviation of the uniform mesh on the part's voxels, mm.
+    pub uniform_deviation: f64,
+    /// Triangles of the uniform mesh on the part's voxels.
+    pub uniform_triangles: u64,
 }
 
 /// How the part was meshed when it was meshed in tiles (see [`crate::mesh::tile`]).
@@ -758,20 +787,16 @@ pub fn write<F: Family>(
             write_instanced(t, plan, m.meshing, m.fragments, o, progress, sink)
         }
         (Route::Whole(_), Made::Whole(mesh)) => {
-            write_whole(mesh.into_mesh(), m.meshing, m.fragments, o, progress, sink)
+            let f = Some(m.fragments);
+            write_part(&solid, mesh, voxel, m.meshing, f, o, progress, sink)
         }
         (Route::Whole(_), Made::Tiles(_)) => {
             // Found on a measuring template: mesh the part at the level found.
-            let (mut mesh, meshing) = {
+            let (mesh, meshing) = {
                 let _p = progress.stage("sampling and meshing");
                 mesh_keyed(&solid, part_spec(&solid, voxel), None, o.adaptivity, None)?
             };
-            let fragments = if o.keep_fragments {
-                pieces::Shells::of(&mesh).fragments(false)
-            } else {
-                pieces::remove_fragments(&mut mesh).0
-            };
-            write_whole(mesh.into_mesh(), meshing, fragments, o, progress, sink)
+            write_part(&solid, mesh, voxel, meshing, None, o, progress, sink)
         }
         (Route::Tiled(edge, _), Made::Tiles(template)) => write_tiled(
             &solid,
@@ -797,6 +822,115 @@ pub fn write<F: Family>(
         ),
         _ => Err(Error::invalid("a part was measured on another route")),
     }
+}
+
+/// Writes the whole part's `mesh`, simplified when a tolerance is asked; its fragments are
+/// `found` already (and removed unless kept), or found and removed here.
+#[allow(clippy::too_many_arguments)]
+fn write_part<S: Solid>(
+    solid: &S,
+    mut mesh: KeyedMesh,
+    voxel: f64,
+    meshing: MeshingStats,
+    found: Option<Fragments>,
+    o: &Options,
+    progress: &Progress,
+    sink: &mut dyn MeshSink,
+) -> Result<Written> {
+    let fragments = match found {
+        Some(f) => f,
+        None if o.keep_fragments => pieces::Shells::of(&mesh).fragments(false),
+        None => pieces::remove_fragments(&mut mesh).0,
+    };
+    let Some(tolerance) = o.tolerance else {
+        return write_whole(mesh.into_mesh(), meshing, fragments, o, progress, sink);
+    };
+    let (mesh, simplified) = {
+        let _p = progress.stage("simplifying");
+        simplify_part(solid, mesh.into_mesh(), voxel, tolerance, o.keep_fragments)?
+    };
+    let mut w = write_whole(mesh, meshing, fragments, o, progress, sink)?;
+    w.simplified = Some(simplified);
+    Ok(w)
+}
+
+/// Simplifies the part's uniform `mesh` (made on `voxel`) within `tolerance` of `solid`'s exact
+/// surface. Where the uniform mesh itself strays further (it rounds the sharp edges where the
+/// box cuts the lattice, or struts meet, by about half a voxel), the part is meshed again on
+/// voxels that much finer first (at most half as large). The result's volume is restored to the uniform
+/// mesh's, which the level search measured; its deviation is measured, and where it exceeds
+/// the tolerance (between the samples each collapse checks) the part is simplified again at a
+/// smaller one.
+fn simplify_part<S: Solid>(
+    solid: &S,
+    mesh: Mesh,
+    voxel: f64,
+    tolerance: f64,
+    keep_fragments: bool,
+) -> Result<(Mesh, Simplified)> {
+    let volume = mesh.volume();
+    let requested_triangles = mesh.triangle_count() as u64;
+    let deviation_on = |m: &Mesh, v: f64| {
+        let field = solid.field(&part_spec(solid, v));
+        let surface = Surface {
+            field: &*field,
+            clip: solid.bounds(),
+        };
+        simplify::deviation(m, surface, 0.25 * v)
+    };
+    let (mut base, mut used) = (mesh, voxel);
+    let mut uniform = deviation_on(&base, used);
+    let requested_deviation = uniform;
+    if uniform > 0.9 * tolerance {
+        // At most half the voxel: four times the triangles to simplify.
+        let finer = used * (0.8 * tolerance / uniform).max(0.5);
+        let (mut keyed, _) = mesh_keyed(solid, part_spec(solid, finer), None, 0.0, None)?;
+        if !keep_fragments {
+            pieces::remove_fragments(&mut keyed);
+        }
+        base = keyed.into_mesh();
+        used = finer;
+        uniform = deviation_on(&base, used);
+    }
+    let field = solid.field(&part_spec(solid, used));
+    let surface = Surface {
+        field: &*field,
+        clip: solid.bounds(),
+    };
+    // Where the uniform mesh strays further than asked even so, those triangles stay as they are
+    // and the rest is held to the tolerance.
+    let bound = tolerance.max(uniform);
+    let report = |stats: SimplifyStats, deviation: f64| Simplified {
+        stats: SimplifyStats { tolerance, ..stats },
+        deviation,
+        voxel: used,
+        uniform_deviation: requested_deviation,
+        uniform_triangles: requested_triangles,
+    };
+    let mut aim = tolerance;
+    for _ in 0..3 {
+        let settings = simplify::Settings {
+            tolerance: aim,
+            voxel: used,
+        };
+        let (out, stats) = simplify::simplify(&base, surface, settings, Some(volume));
+        let deviation = simplify::deviation(&out, surface, 0.25 * used);
+        if deviation <= bound {
+            return Ok((out, report(stats, deviation)));
+        }
+        aim *= 0.75;
+    }
+    let still = vec![false; base.vertex_count()];
+    let offset = simplify::restore_volume(&mut base, surface, used, volume, &still);
+    let stats = SimplifyStats {
+        triangles_before: base.triangle_count() as u64,
+        triangles_after: base.triangle_count() as u64,
+        offset,
+        gave_up: true,
+        ..Default::default()
+    };
+    let deviation = simplify::deviation(&base, surface, 0.25 * used);
+    Ok((base, report(stats, deviation)))
 }
 
 fn write_instanced(
@@ -842,6 +976,7 @@ fn write_instanced(
             verified: "template",
         }),
         tiling: None,
+        simplified: None,
         verify_seconds,
         write_seconds,
     })
@@ -927,6 +1062,7 @@ fn write_tiled<S: Solid>(
                 Verify::None => "not verified",
             },
         }),
+        simplified: None,
         verify_seconds: 0.0,
         write_seconds: t.elapsed().as_secs_f64(),
     })
@@ -969,6 +1105,7 @@ fn write_whole(
         fragments,
         instancing: None,
         tiling: None,
+        simplified: None,
         verify_seconds,
         write_seconds,
     })

@@ -5,7 +5,9 @@
 //! flattens this one into it, so every report has the same keys for the same things.
 
 use super::pieces::Fragments;
-use super::pipeline::{Instancing, Made, Measured, MeshingStats, Route, Tiling, Written, PROMISE};
+use super::pipeline::{
+    Instancing, Made, Measured, MeshingStats, Route, Simplified, Tiling, Written, PROMISE,
+};
 use super::resolution::ResolutionMiss;
 use crate::field::Aabb;
 use crate::verify::cgal::Verification;
@@ -101,6 +103,9 @@ pub struct PartReport {
     pub instancing: Option<Instancing>,
     /// Set when the part was meshed in tiles.
     pub tiling: Option<Tiling>,
+    /// Set when the mesh was simplified within a tolerance: the tolerance, the largest
+    /// deviation measured on the written mesh, the triangles before and after.
+    pub simplified: Option<Simplified>,
     /// Meshing statistics over every meshing of the job.
     pub meshing: MeshingStats,
     /// Wall time of each stage.
@@ -149,6 +154,7 @@ impl PartReport {
             one_piece,
             instancing: written.instancing,
             tiling: written.tiling,
+            simplified: written.simplified,
             timings: Timings {
                 sample: meshing.sample_seconds,
                 mesh: meshing.mesh_seconds,

@@ -34,6 +34,8 @@ pub struct TpmsJob {
     pub resolution: u32,
     /// OpenVDB volumeToMesh adaptivity, 0 (uniform) to 1.
     pub adaptivity: f64,
+    /// Simplify the mesh within this distance of the exact surface, mm.
+    pub tolerance: Option<f64>,
     /// Build even if the solid falls apart into islands at this density.
     pub allow_islands: bool,
     /// Raise the resolution when sheet walls would be thinner than [`MIN_WALL_VOXELS`].
@@ -339,6 +341,7 @@ impl TpmsJob {
     pub(super) fn options(&self, instancing: bool, islands: bool) -> Options {
         Options {
             adaptivity: self.adaptivity,
+            tolerance: self.tolerance,
             verify: self.verify,
             instancing,
             tile: self.tile,

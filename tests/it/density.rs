@@ -41,6 +41,7 @@ fn hits_targets(all: bool) {
                     domain: Domain::from_cells([3; 3], [5.0; 3], [0.0; 3]).unwrap(),
                     resolution: 32,
                     adaptivity: 0.0,
+                    tolerance: None,
                     allow_islands: true,
                     auto_resolution: true,
                     verify: latvox::verify::Verify::Full,

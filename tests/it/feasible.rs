@@ -111,6 +111,7 @@ fn refusals_are_typed_errors_that_carry_their_data() {
         domain: Domain::from_cells([2; 3], [5.0; 3], [0.0; 3]).unwrap(),
         resolution,
         adaptivity: 0.0,
+        tolerance: None,
         allow_islands: false,
         auto_resolution,
         verify: latvox::verify::Verify::Fast,

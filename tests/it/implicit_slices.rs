@@ -489,6 +489,7 @@ fn fragments_found_tile_by_tile_are_the_whole_parts() {
         domain: Domain::from_size_and_cell([11.0, 6.0, 9.0], [5.0; 3], [0.0; 3]).unwrap(),
         resolution: 32,
         adaptivity: 0.0,
+        tolerance: None,
         allow_islands: false,
         auto_resolution: true,
         verify: latvox::verify::Verify::Fast,

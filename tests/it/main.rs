@@ -30,6 +30,7 @@ mod python;
 mod render;
 mod scale;
 mod self_intersect;
+mod simplify;
 mod slice;
 mod slurm;
 mod strut;

@@ -78,6 +78,7 @@ fn tpms_mesh(surface: Surface, structure: Structure, cells: u32, resolution: u32
         domain: Domain::from_cells([cells; 3], [5.0; 3], [0.0; 3]).unwrap(),
         resolution,
         adaptivity: 0.0,
+        tolerance: None,
         allow_islands: true,
         auto_resolution: true,
         verify: Verify::None,
