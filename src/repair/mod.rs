@@ -158,6 +158,18 @@ impl Work {
 
     /// Step 1 (run again after steps that can collapse facets).
     fn remove_bad_facets(&mut self) {
+        // Zero-area facets whose middle vertex lies inside their longest edge are folded into
+        // the facet across that edge first: cutting them out would leave a hole whose only
+        // filling is another sliver.
+        for _ in 0..3 {
+            let (mesh, topo) = self.parts();
+            let bad = check::FacetDefects::find(mesh, topo);
+            let folded = fold_caps(&mut self.mesh, &bad);
+            self.note("zero-area facets folded into their neighbours", folded);
+            if folded == 0 {
+                break;
+            }
+        }
         let (mesh, topo) = self.parts();
         let bad = check::FacetDefects::find(mesh, topo);
         let zero_count = bad.zero_area_count();
@@ -302,6 +314,91 @@ impl Work {
         );
         Ok(active)
     }
+}
+
+/// Folds each zero-area facet `(a, b, c)` whose vertex `c` lies inside its longest edge `ab`
+/// (a "cap") into the facet `g` across that edge: `g = (x, y, d)` on the edge `{a, b}` becomes
+/// `(x, c, d)` and `(c, y, d)`, which keep `g`'s winding and split its edge at `c`, and the cap
+/// goes. The neighbours of the cap's other two edges then meet those two facets instead: the
+/// surface is the same and closed where it was. Facets whose vertices coincide ("needles"),
+/// stray caps (a short edge meets no other facet) and caps without a facet across, or whose
+/// facet there is degenerate too, are left (and removed as before). Returns the caps folded.
+fn fold_caps(mesh: &mut Mesh, bad: &check::FacetDefects) -> u64 {
+    use std::collections::HashMap;
+    let n = mesh.triangle_count();
+    let tri = |m: &Mesh, f: usize| [m.indices[3 * f], m.indices[3 * f + 1], m.indices[3 * f + 2]];
+    let mut by_edge: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    for f in 0..n {
+        let t = tri(mesh, f);
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            by_edge
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push(f as u32);
+        }
+    }
+    let mut touched = vec![false; n];
+    let mut gone = vec![false; n];
+    let mut added: Vec<u32> = Vec::new();
+    let mut folded = 0;
+    for f in 0..n {
+        if !bad.zero_area[f] || touched[f] {
+            continue;
+        }
+        let t = tri(mesh, f);
+        let p = t.map(|v| mesh.vertex(v));
+        let len = |k: usize| crate::geom::norm(sub(p[(k + 1) % 3], p[k]));
+        let k = (0..3)
+            .max_by(|&i, &j| len(i).total_cmp(&len(j)))
+            .expect("three edges");
+        let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+        // A needle: c on a or b, nothing to split.
+        let short = len((k + 1) % 3).min(len((k + 2) % 3));
+        if short <= 1e-6 * len(k) {
+            continue;
+        }
+        // Only a cap that is part of the surface: its short edges meet other facets (a stray
+        // degenerate facet is removed instead).
+        let shared = |p: u32, q: u32| by_edge[&(p.min(q), p.max(q))].len() >= 2;
+        if !shared(a, c) || !shared(c, b) {
+            continue;
+        }
+        let Some(&g) = by_edge[&(a.min(b), a.max(b))]
+            .iter()
+            .find(|&&g| g as usize != f && !touched[g as usize] && !bad.zero_area[g as usize])
+        else {
+            continue;
+        };
+        let gt = tri(mesh, g as usize);
+        let Some(i) = (0..3).find(|&i| {
+            let (x, y) = (gt[i], gt[(i + 1) % 3]);
+            (x == a && y == b) || (x == b && y == a)
+        }) else {
+            continue;
+        };
+        let (x, y, d) = (gt[i], gt[(i + 1) % 3], gt[(i + 2) % 3]);
+        if d == c {
+            continue;
+        }
+        mesh.indices[3 * g as usize..3 * g as usize + 3].copy_from_slice(&[x, c, d]);
+        added.extend_from_slice(&[c, y, d]);
+        gone[f] = true;
+        touched[f] = true;
+        touched[g as usize] = true;
+        folded += 1;
+    }
+    if folded > 0 {
+        let mut out = Vec::with_capacity(mesh.indices.len() + added.len());
+        for (f, gone) in gone.iter().enumerate() {
+            if !gone {
+                out.extend_from_slice(&tri(mesh, f));
+            }
+        }
+        out.extend_from_slice(&added);
+        mesh.indices = out;
+    }
+    folded
 }
 
 /// Repairs `mesh`. Returns the repaired mesh and what was done.

@@ -1546,3 +1546,37 @@ fn a_shell_crossing_itself_is_remeshed_at_its_size() {
     let v = latvox::verify::cgal::verify(&m, true).unwrap();
     assert!(v.closed && v.manifold && !v.self_intersecting, "{v:?}");
 }
+
+/// A real slicer mesh whose only defects are two zero-area facets (Cura's Tronxy platform:
+/// each a "cap", 0.4 mm high on a 13.9 mm edge). Repair folds each into the facet across its
+/// long edge instead of cutting it out, which left a hole only another sliver could fill (and
+/// exit 1): the result is a valid solid of the same volume, exit 0, with and without `--solid`.
+#[test]
+fn zero_area_facets_are_folded_away() {
+    let dir = tempdir();
+    let input = slicer_mesh("cura", "tronxy.stl");
+    let (code, v) = check_json(&input, &[]);
+    assert_eq!(code, 1, "the caps are defects");
+    assert_eq!(u(&v["check"]["zero_area_facets"]), 2);
+    assert_eq!(
+        u(&v["check"]["boundary_edges"]) + u(&v["check"]["self_intersections"]),
+        0
+    );
+    let before = v["check"]["volume"].as_f64().unwrap();
+    for extra in [&[][..], &["--solid"][..]] {
+        let output = dir.path().join("fixed.stl");
+        let (code, r) = repair_json(&input, &output, extra);
+        assert_eq!(code, 0, "{extra:?}: {r}");
+        let fixed = crate::common::read_stl(&output);
+        let t = meshkit::topo(&fixed);
+        assert_eq!((t.boundary, t.non_manifold), (0, 0), "{extra:?}");
+        let v = meshkit::volume(&fixed);
+        assert!(
+            (v - before).abs() <= 1e-4 * before,
+            "{extra:?}: {v} mm³, not {before}"
+        );
+        let (code, c) = check_json(&output, &[]);
+        assert_eq!(code, 0, "{extra:?}: {c}");
+        assert_eq!(u(&c["check"]["zero_area_facets"]), 0);
+    }
+}
