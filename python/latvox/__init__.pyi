@@ -158,8 +158,8 @@ def tpms(
     resolution: Voxels per cell along the cell's shortest side (default: 32)
     fixed_resolution: Fail instead of raising the resolution when the lattice's members would be too
         thin for the voxels
-    adaptivity: OpenVDB mesh adaptivity: 0 keeps uniform triangles, up to 1 merges flat regions
-        (default: 0)
+    adaptivity: Kept for older scripts: simplify within this many voxels, 0 to 1 (0.5: half a
+        voxel); --tolerance says it in millimetres and wins over it (default: 0)
     tolerance: Simplify the mesh: the largest distance allowed between it and the exact surface, mm.
         Flat regions get large triangles, curved ones small; every vertex stays on the surface, the
         density is kept, and the deviation is measured and reported. Without it the mesh is uniform
@@ -259,8 +259,8 @@ def strut(
     resolution: Voxels per cell along the cell's shortest side (default: 32)
     fixed_resolution: Fail instead of raising the resolution when the lattice's members would be too
         thin for the voxels
-    adaptivity: OpenVDB mesh adaptivity: 0 keeps uniform triangles, up to 1 merges flat regions
-        (default: 0)
+    adaptivity: Kept for older scripts: simplify within this many voxels, 0 to 1 (0.5: half a
+        voxel); --tolerance says it in millimetres and wins over it (default: 0)
     tolerance: Simplify the mesh: the largest distance allowed between it and the exact surface, mm.
         Flat regions get large triangles, curved ones small; every vertex stays on the surface, the
         density is kept, and the deviation is measured and reported. Without it the mesh is uniform
@@ -363,8 +363,8 @@ def fill(
     resolution: Voxels per cell along the cell's shortest side (default: 32)
     fixed_resolution: Fail instead of raising the resolution when the lattice's members would be too
         thin for the voxels
-    adaptivity: OpenVDB mesh adaptivity: 0 keeps uniform triangles, up to 1 merges flat regions
-        (default: 0)
+    adaptivity: Kept for older scripts: simplify within this many voxels, 0 to 1 (0.5: half a
+        voxel); --tolerance says it in millimetres and wins over it (default: 0)
     tolerance: Simplify the mesh: the largest distance allowed between it and the exact surface, mm.
         Flat regions get large triangles, curved ones small; every vertex stays on the surface, the
         density is kept, and the deviation is measured and reported. Without it the mesh is uniform

@@ -191,7 +191,8 @@ pub struct MeshArgs {
     /// for the voxels.
     #[arg(long)]
     pub fixed_resolution: bool,
-    /// OpenVDB mesh adaptivity: 0 keeps uniform triangles, up to 1 merges flat regions.
+    /// Kept for older scripts: simplify within this many voxels, 0 to 1 (0.5: half a voxel);
+    /// --tolerance says it in millimetres and wins over it.
     #[arg(long, default_value_t = 0.0, value_parser = parse_unit)]
     pub adaptivity: f64,
     /// Simplify the mesh: the largest distance allowed between it and the exact surface, mm.

@@ -198,7 +198,9 @@ pub fn part_spec<S: Solid + ?Sized>(solid: &S, voxel: f64) -> GridSpec {
 /// How the part is written, and what it is meshed with.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Options {
-    /// OpenVDB volumeToMesh adaptivity, 0 (uniform) to 1; above 0 the part is meshed whole.
+    /// The name `--adaptivity` had for OpenVDB's volumeToMesh adaptivity, 0 to 1, kept as a
+    /// tolerance of that many voxels ([`Options::tolerance_at`]): OpenVDB's adaptive meshes
+    /// could cross themselves.
     pub adaptivity: f64,
     /// Simplify the mesh within this distance of the exact surface, mm (see
     /// [`crate::mesh::simplify`]); the part is then meshed whole and its density measured on
@@ -214,6 +216,15 @@ pub struct Options {
     pub memory: Option<u64>,
     /// Keep the fragments the box cuts loose (they are removed by default).
     pub keep_fragments: bool,
+}
+
+impl Options {
+    /// The tolerance the mesh is simplified within on voxels of `voxel` mm: the one asked, or
+    /// `adaptivity` voxels.
+    pub fn tolerance_at(&self, voxel: f64) -> Option<f64> {
+        self.tolerance
+            .or((self.adaptivity > 0.0).then_some(self.adaptivity * voxel))
+    }
 }
 
 /// How a part is meshed and written.
@@ -236,10 +247,8 @@ impl Route {
         let plan = |f: fn(Vec3, Vec3, f64) -> Option<[AxisPlan; 3]>| {
             solid.period().and_then(|c| f(bounds.size(), c, voxel))
         };
-        if o.adaptivity != 0.0 {
-            return Route::Whole(None);
-        }
-        if o.instancing && o.tile.is_none() && o.tolerance.is_none() {
+        let simplified = o.tolerance_at(voxel).is_some();
+        if o.instancing && o.tile.is_none() && !simplified {
             if let Some(p) = plan(instance::plan) {
                 return Route::Instanced(p);
             }
@@ -278,7 +287,7 @@ impl Route {
             let cell = solid.period().expect("a plan needs a period");
             part >= 4 * template && fits(&instance::template_bounds(&bounds, cell, p))
         });
-        if o.tolerance.is_some() {
+        if simplified {
             // Simplified whole (copies and tiles would need their seams held).
             return Route::Whole(measuring);
         }
@@ -364,8 +373,7 @@ pub fn measure_observed<F: Family>(
             (made, v, f, stats)
         }
         Route::Whole(None) => {
-            let (mut mesh, stats) =
-                mesh_keyed(&solid, part_spec(&solid, voxel), None, o.adaptivity, None)?;
+            let (mut mesh, stats) = mesh_keyed(&solid, part_spec(&solid, voxel), None, 0.0, None)?;
             let f = if o.keep_fragments {
                 pieces::Shells::of(&mesh).fragments(false)
             } else {
@@ -794,7 +802,7 @@ pub fn write<F: Family>(
             // Found on a measuring template: mesh the part at the level found.
             let (mesh, meshing) = {
                 let _p = progress.stage("sampling and meshing");
-                mesh_keyed(&solid, part_spec(&solid, voxel), None, o.adaptivity, None)?
+                mesh_keyed(&solid, part_spec(&solid, voxel), None, 0.0, None)?
             };
             write_part(&solid, mesh, voxel, meshing, None, o, progress, sink)
         }
@@ -842,7 +850,7 @@ fn write_part<S: Solid>(
         None if o.keep_fragments => pieces::Shells::of(&mesh).fragments(false),
         None => pieces::remove_fragments(&mut mesh).0,
     };
-    let Some(tolerance) = o.tolerance else {
+    let Some(tolerance) = o.tolerance_at(voxel) else {
         return write_whole(mesh.into_mesh(), meshing, fragments, o, progress, sink);
     };
     let (mesh, simplified) = {

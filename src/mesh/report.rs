@@ -197,6 +197,12 @@ impl PartReport {
                 self.checks.checked_by
             ));
         }
+        if let Some(s) = self.simplified.filter(|s| s.deviation > s.stats.tolerance) {
+            warnings.push(format!(
+                "the mesh strays {:.4} mm from the exact surface, more than the tolerance {} mm: the uniform mesh already did at the box's cut edges or where members meet (a finer --resolution brings it within)",
+                s.deviation, s.stats.tolerance
+            ));
+        }
         let fragments = &self.fragments;
         if fragments.count > 0 {
             warnings.push(format!(

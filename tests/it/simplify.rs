@@ -247,3 +247,28 @@ fn tolerance_must_be_a_positive_length() {
         assert_refusal(dir.path(), &before, &out, &args, "tolerance");
     }
 }
+
+/// `--adaptivity`, once OpenVDB's adaptive meshing (a 4×4×4-cell gyroid net at 0.3 came out
+/// self-intersecting at 0.1 and 0.3), is now a tolerance of that many voxels: valid by CGAL, its
+/// density kept, fewer triangles than the uniform mesh.
+#[test]
+fn adaptivity_is_a_tolerance_in_voxels() {
+    let dir = tempdir();
+    let d = dir.path();
+    let line = "tpms --type gyroid --density 0.3 --cells 4 --adaptivity 0.3 --verify cgal";
+    let args: Vec<&str> = line
+        .split(' ')
+        .chain(["-o", "a.stl", "--report", "a.json"])
+        .collect();
+    ok(&args, d);
+    let r = json(&d.join("a.json"));
+    assert_eq!(r["checks"]["checked_by"], "CGAL");
+    assert_eq!(r["checks"]["self_intersecting"], false);
+    assert_eq!(r["checks"]["closed"], true);
+    let s = &r["simplified"];
+    let voxel = r["voxel_size"].as_f64().unwrap();
+    assert!((s["tolerance"].as_f64().unwrap() - 0.3 * voxel).abs() < 1e-12);
+    let tris = read_stl(&d.join("a.stl"));
+    assert!((volume(&tris) / 8000.0 - 0.3).abs() <= 0.002);
+    assert!(tris.len() * 5 < s["uniform_triangles"].as_u64().unwrap() as usize);
+}
