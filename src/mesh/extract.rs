@@ -215,7 +215,7 @@ impl KeyedMesh {
 
 /// Shape quality of a triangle: twice its area over the sum of its squared edge lengths (0 for a
 /// sliver, largest for an equilateral triangle).
-fn quality(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+pub(crate) fn quality(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     use crate::geom::{cross, dot, norm, sub};
     let (ab, bc, ca) = (sub(b, a), sub(c, b), sub(a, c));
     let s = dot(ab, ab) + dot(bc, bc) + dot(ca, ca);

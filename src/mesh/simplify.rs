@@ -700,20 +700,14 @@ impl<'a> Collapser<'a> {
     }
 }
 
-/// Quality of the equilateral triangle by [`quality`].
+/// Quality of the equilateral triangle by [`crate::mesh::extract::quality`].
 const EQUILATERAL: f64 = 0.288_675_134_594_812_9; // √3 / 6
 
 fn normal(t: &[Vec3; 3]) -> Vec3 {
     cross(sub(t[1], t[0]), sub(t[2], t[0]))
 }
 
-/// Twice the area over the sum of the squared edges.
+/// [`crate::mesh::extract::quality`] of a triangle given as its corners.
 fn quality(t: &[Vec3; 3]) -> f64 {
-    let (ab, bc, ca) = (sub(t[1], t[0]), sub(t[2], t[1]), sub(t[0], t[2]));
-    let s = dot(ab, ab) + dot(bc, bc) + dot(ca, ca);
-    if s > 0.0 {
-        norm(normal(t)) / s
-    } else {
-        0.0
-    }
+    crate::mesh::extract::quality(t[0], t[1], t[2])
 }
