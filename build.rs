@@ -22,6 +22,7 @@ const CGAL_CHECK_UNIT: &str = "cpp/cgal_check.cc";
 const CGAL_REPAIR_UNIT: &str = "cpp/cgal_repair.cc";
 const CGAL_BOOLEAN_UNIT: &str = "cpp/cgal_boolean.cc";
 const CGAL_DISTANCE_UNIT: &str = "cpp/cgal_distance.cc";
+const CGAL_VORONOI_UNIT: &str = "cpp/cgal_voronoi.cc";
 
 const INSTALL_HINT: &str = "run `bash scripts/install-deps.sh` (Debian bookworm: libopenvdb-dev, libcgal-dev, libtbb-dev, libgmp-dev, libmpfr-dev, libeigen3-dev)";
 
@@ -93,6 +94,9 @@ fn main() {
     cgal_distance
         .define("CGAL_LINKED_WITH_TBB", None)
         .file(CGAL_DISTANCE_UNIT);
+    let mut cgal_voronoi = cxx_build::bridges(std::iter::empty::<&str>());
+    flags(&mut cgal_voronoi);
+    cgal_voronoi.file(CGAL_VORONOI_UNIT);
 
     // The libraries compile side by side (and, with cc's `parallel`, the units of each): the
     // CGAL units take most of the build, and one at a time they leave the other cores idle.
@@ -102,6 +106,7 @@ fn main() {
         (cgal_repair, "latvox_cgal_repair"),
         (cgal_boolean, "latvox_cgal_boolean"),
         (cgal_distance, "latvox_cgal_distance"),
+        (cgal_voronoi, "latvox_cgal_voronoi"),
     ];
     std::thread::scope(|s| {
         for (build, name) in &libs {
@@ -130,6 +135,7 @@ fn main() {
             CGAL_REPAIR_UNIT,
             CGAL_BOOLEAN_UNIT,
             CGAL_DISTANCE_UNIT,
+            CGAL_VORONOI_UNIT,
         ])
     {
         println!("cargo:rerun-if-changed={f}");

@@ -16,24 +16,11 @@
 use std::path::Path;
 use std::process::Command;
 mod support;
-use support::{latvox, median, runs_arg};
+use support::{latvox, median, runs_arg, time_and_peak};
 
-/// Wall seconds and peak resident memory (MB) of `cmd`, run under `/usr/bin/time`.
+/// Wall seconds and peak resident memory (MB) of latvox with `args`.
 fn timed(dir: &Path, args: &[&str]) -> (f64, f64) {
-    let out = dir.join("time.txt");
-    let s = Command::new("/usr/bin/time")
-        .args(["-f", "%e %M", "-o", out.to_str().unwrap()])
-        .arg(env!("CARGO_BIN_EXE_latvox"))
-        .args(args)
-        .current_dir(dir)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .status()
-        .unwrap();
-    assert!(s.success(), "latvox {args:?}");
-    let t = std::fs::read_to_string(out).unwrap();
-    let v: Vec<f64> = t.split_whitespace().map(|x| x.parse().unwrap()).collect();
-    (v[0], v[1] / 1024.0)
+    time_and_peak(dir, env!("CARGO_BIN_EXE_latvox"), args)
 }
 
 fn read_stl(path: &Path) -> Vec<[[f64; 3]; 3]> {

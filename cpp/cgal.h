@@ -2,7 +2,8 @@
 // (cgal_check.cc); self-intersections of any soup and hole filling, the repair steps
 // (cgal_repair.cc, compiled apart with its own CGAL settings); the union of closed shells by
 // corefinement (cgal_boolean.cc); distances from points to a soup and rays from its facets
-// (cgal_distance.cc). One header for the whole library.
+// (cgal_distance.cc); the Voronoi diagram of points, dual of their Delaunay triangulation
+// (cgal_voronoi.cc). One header for the whole library.
 #pragma once
 #include <cstdint>
 #include "rust/cxx.h"
@@ -14,6 +15,7 @@ struct SoupIntersections;
 struct HoleFill;
 struct ShellUnion;
 struct PointDistances;
+struct VoronoiDiagram;
 
 // cgal_check.cc
 CgalReport cgal_check(rust::Slice<const float> positions, rust::Slice<const uint32_t> indices,
@@ -39,5 +41,8 @@ PointDistances cgal_distances(rust::Slice<const float> positions,
                               rust::Slice<const double> points, bool classify);
 rust::Vec<double> cgal_facet_reach(rust::Slice<const float> positions,
                                    rust::Slice<const uint32_t> indices);
+
+// cgal_voronoi.cc
+VoronoiDiagram cgal_voronoi(rust::Slice<const double> points);
 
 }  // namespace latvox

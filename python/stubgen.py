@@ -18,6 +18,7 @@ from latvox import _latvox  # noqa: E402
 FUNCTIONS = {
     "tpms": ("", "Mesh"),
     "strut": ("", "Mesh"),
+    "voronoi": ("", "Mesh"),
     "fill": ("input: MeshLike | None = None, ", "Mesh"),
     "fgm": ("", "Mesh"),
     "interpret": ("input: Union[str, os.PathLike, np.ndarray, Density], ", "Mesh"),

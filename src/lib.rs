@@ -76,5 +76,6 @@ pub mod strut;
 pub mod topopt;
 pub mod tpms;
 pub mod verify;
+pub mod voronoi;
 
 pub use error::{Error, Result};

@@ -1,6 +1,7 @@
 //! What the benchmarks share: the process's peak memory, a sink that makes STL records and
 //! drops them (the writing of a part too large for this machine's disk, without the disk),
-//! a torus mesh, latvox as a quiet child process, medians and the `--runs` argument.
+//! a torus mesh, latvox as a quiet child process, a command's time and peak memory, medians and
+//! the `--runs` argument.
 #![allow(dead_code)]
 
 use latvox::geom::Mesh;
@@ -93,6 +94,26 @@ pub fn latvox(dir: &std::path::Path, args: &[&str]) -> std::process::Command {
         .stdout(Stdio::null())
         .stderr(Stdio::null());
     c
+}
+
+/// Wall seconds and peak resident memory (MB) of `program` with `args` run in `dir` under
+/// `/usr/bin/time`, its output dropped; panics when it fails.
+pub fn time_and_peak(dir: &std::path::Path, program: &str, args: &[&str]) -> (f64, f64) {
+    use std::process::Stdio;
+    let out = dir.join("time.txt");
+    let s = std::process::Command::new("/usr/bin/time")
+        .args(["-f", "%e %M", "-o", out.to_str().unwrap()])
+        .arg(program)
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(s.success(), "{program} {args:?}");
+    let t = std::fs::read_to_string(out).unwrap();
+    let v: Vec<f64> = t.split_whitespace().map(|x| x.parse().unwrap()).collect();
+    (v[0], v[1] / 1024.0)
 }
 
 /// The middle value of `v` (the upper one of an even count).

@@ -40,6 +40,7 @@ __all__ = [
     "BackendError",
     "tpms",
     "strut",
+    "voronoi",
     "fill",
     "fgm",
     "topopt",
@@ -422,6 +423,12 @@ def strut(*, strict: bool = False, progress=None, threads: Optional[int] = None,
                 threads=threads, read=_mesh_result)
 
 
+def voronoi(*, strict: bool = False, progress=None, threads: Optional[int] = None,
+            **options) -> Mesh:
+    return _run("voronoi", options, output="part.stl", strict=strict, progress=progress,
+                threads=threads, read=_mesh_result)
+
+
 def fill(input: Any = None, *, strict: bool = False, progress=None,
          threads: Optional[int] = None, **options) -> Mesh:
     if input is not None:
@@ -521,6 +528,7 @@ def render(part: Any, width: int = 800, height: int = 600, *, progress=None,
 _COMMANDS: Dict[str, Callable[..., Any]] = {
     "tpms": tpms,
     "strut": strut,
+    "voronoi": voronoi,
     "fill": fill,
     "fgm": fgm,
     "interpret": interpret,
@@ -535,6 +543,7 @@ _COMMANDS: Dict[str, Callable[..., Any]] = {
 _CALLS = {
     "tpms": "tpms(**options)",
     "strut": "strut(**options)",
+    "voronoi": "voronoi(**options)",
     "fill": "fill(input, **options)",
     "fgm": "fgm(**options)",
     "interpret": "interpret(input, **options)",
@@ -549,6 +558,7 @@ _CALLS = {
 _RETURNS = {
     "tpms": "a Mesh (its report as --report writes it)",
     "strut": "a Mesh (its report as --report writes it)",
+    "voronoi": "a Mesh (its report as --report writes it)",
     "fill": "a Mesh (its report as --report writes it)",
     "fgm": "a Mesh (its report as --report writes it)",
     "interpret": "a Mesh (its report as --report writes it)",

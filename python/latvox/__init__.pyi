@@ -294,6 +294,97 @@ def strut(
     """
     ...
 
+def voronoi(
+    *,
+    structure: Optional[Value] = None,
+    spacing: Optional[Value] = None,
+    spacing_field: Optional[Value] = None,
+    seed: Optional[Value] = None,
+    regularity: Optional[Value] = None,
+    seeds_in: Optional[Value] = None,
+    seeds_out: Optional[Value] = None,
+    density: Optional[Value] = None,
+    radius: Optional[Value] = None,
+    thickness: Optional[Value] = None,
+    size: Optional[Value] = None,
+    origin: Optional[Value] = None,
+    resolution: Optional[Value] = None,
+    fixed_resolution: bool = False,
+    adaptivity: Optional[Value] = None,
+    tolerance: Optional[Value] = None,
+    output: Optional[Value] = None,
+    ascii: bool = False,
+    report: Optional[Value] = None,
+    verify: Optional[Value] = None,
+    no_self_intersection_check: bool = False,
+    no_instancing: bool = False,
+    memory: Optional[Value] = None,
+    tile: Optional[Value] = None,
+    keep_fragments: bool = False,
+    save_part: Optional[Value] = None,
+    part: Optional[Value] = None,
+    strict: bool = False,
+    progress: Progress = None,
+    threads: Optional[int] = None,
+) -> Mesh:
+    """
+    Generate a Voronoi foam — struts along the edges or walls along the faces of a random (or
+        graded, or partly regular) Voronoi diagram — at an exact volume fraction.
+
+    structure: Struts along the Voronoi edges (net) or walls along its faces (sheet) (default: net)
+        [net, sheet]
+    spacing: Mean spacing of the seeds, mm: the edge of the mean cell (default: 3)
+    spacing_field: A spacing that varies through the box (instead of --spacing): an expression in x,
+        y, z (mm), a .npy array spanning the box, or a .vdb grid
+    seed: The random generator's seed: the same seed gives the same foam, byte for byte (default: 1)
+    regularity: Move the seeds toward the body-centred cubic lattice: 0 random, 1 the Kelvin foam
+        (default: 0)
+    seeds_in: Your own seeds: a CSV file of x,y,z per line, mm (they should fill the box and a
+        margin of a cell or two round it)
+    seeds_out: Write the seeds used (box and margin) to a CSV file
+    density: Target volume fraction of solid, in (0, 1) (0.15 when no size is given)
+    radius: Strut radius of a net, mm, instead of a density
+    thickness: Wall thickness of a sheet, mm, instead of a density
+    size: Box size in mm: S or SX,SY,SZ (default: 20)
+    origin: Lower corner of the box in mm (default: 0,0,0)
+    resolution: Voxels per cell along the cell's shortest side (default: 32)
+    fixed_resolution: Fail instead of raising the resolution when the lattice's members would be too
+        thin for the voxels
+    adaptivity: Kept for older scripts: simplify within this many voxels, 0 to 1 (0.5: half a
+        voxel); --tolerance says it in millimetres and wins over it (default: 0)
+    tolerance: Simplify the mesh: the largest distance allowed between it and the exact surface, mm.
+        Flat regions get large triangles, curved ones small; every vertex stays on the surface, the
+        density is kept, and the deviation is measured and reported. Without it the mesh is uniform
+        (two triangles per voxel the surface crosses): its deviation is about half a voxel at the
+        box's cut edges and where struts meet, so half a voxel (cell / resolution / 2, 0.078 mm for
+        5 mm cells at 32) keeps that deviation with 10–30× fewer triangles. A smaller one meshes the
+        part on voxels up to half as large first. The part is then meshed whole (not copied cell by
+        cell, nor in tiles)
+    output: Output mesh, in the format its extension names: .stl (binary, ASCII with --ascii) or
+        .3mf, streamed to the file as it is made; .obj, .off or .ply (binary, ASCII with --ascii),
+        written once the part is whole; .vdb, the part's level set at its voxels (OpenVDB, a grid
+        named sdf) (default: lattice.stl)
+    ascii: Write ASCII STL (or ASCII PLY) instead of binary
+    report: Write a JSON report (settings, densities, mesh counts, checks, timings)
+    verify: How the part is verified: full (closed, manifold, outward and no self-intersection,
+        exact, on the whole written part), fast (no self-intersection search), none, or cgal (CGAL's
+        own checks, an independent second opinion, several times slower) (default: full) [full,
+        fast, none, cgal]
+    no_self_intersection_check: The same as --verify fast
+    no_instancing: Mesh the whole part at once instead of copying its periodic cells from a meshed
+        3×3×3-cell template (slower, same solid; the whole part is then verified)
+    memory: Memory budget while meshing, e.g. 2G or 512M: a part whose grid would not fit is meshed
+        in tiles sized from it and streamed to the file (default 4G)
+    tile: Mesh in tiles of this many voxels a side (a multiple of 8, at least 16), whatever the
+        part's size; the tiled part is the same solid as the untiled one
+    keep_fragments: Keep the pieces the box cuts loose from the lattice (by default they are
+        removed, so that the part is one piece; the summary and report count them either way)
+    save_part: Save the settings that define this part (all but where its files go) to a TOML part
+        file, once the part is made
+    part: Make the part a part file describes (options given here override the file's)
+    """
+    ...
+
 def fill(
     input: MeshLike | None = None, *,
     input: Optional[Value] = None,

@@ -69,6 +69,15 @@ def test_strut_takes_tuples_and_reports_its_density():
     assert t.bounds[1] == pytest.approx([10, 10, 5], abs=1e-3)
 
 
+def test_voronoi_foam_at_its_density_and_the_same_seed_again():
+    a = latvox.voronoi(spacing=3.0, density=0.15, size=(10.0, 8.0, 6.0), resolution=10, seed=4)
+    t = closed_solid(a)
+    assert t.volume / (10 * 8 * 6) == pytest.approx(0.15, abs=0.002)
+    assert a.report["foam"]["cells"] > 10
+    b = latvox.voronoi(spacing=3.0, density=0.15, size=(10.0, 8.0, 6.0), resolution=10, seed=4)
+    assert np.array_equal(a.vertices, b.vertices)
+
+
 def test_fill_a_part_with_a_lattice():
     m = latvox.fill(str(EXAMPLES / "sphere.obj"), lattice="gyroid", density=0.2, skin=1.0,
                     cell_size=6.0, resolution=12)

@@ -323,6 +323,18 @@ pub(crate) fn triple(v: [f64; 3]) -> String {
 }
 
 /// The summary's lines on the part written: mesh, bounds, pieces, checks, time, file.
+/// The density line of a part made to a density (or with one measured).
+pub(crate) fn print_density(p: &PartReport) {
+    match p.target_density {
+        Some(t) => outln!(
+            "density   target {t:.4}  achieved {:.4}  (error {:+.5})",
+            p.achieved_density,
+            p.density_error.unwrap_or(f64::NAN)
+        ),
+        None => outln!("density   {:.4}", p.achieved_density),
+    }
+}
+
 pub(crate) fn print_part(r: &PartReport) {
     outln!(
         "mesh      {} triangles, {} vertices, area {:.2} mm², volume {:.2} mm³",

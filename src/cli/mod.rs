@@ -19,6 +19,7 @@ pub mod strut;
 pub mod topopt;
 pub mod tpms;
 pub mod view;
+pub mod voronoi;
 
 use latvox::Result;
 use std::path::{Path, PathBuf};
@@ -27,6 +28,7 @@ use std::path::{Path, PathBuf};
 pub(crate) const COMMANDS: &[&command::Command] = &[
     &tpms::COMMAND,
     &strut::COMMAND,
+    &voronoi::COMMAND,
     &fill::COMMAND,
     &check::COMMAND,
     &repair::COMMAND,

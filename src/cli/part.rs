@@ -79,6 +79,11 @@ const EXCLUSIVE: &[[&str; 2]] = &[
     ["radius", "stiffness-field"],
     ["density-grade", "stiffness-field"],
     ["density-field", "stiffness-field"],
+    ["density", "thickness"],
+    ["radius", "thickness"],
+    ["spacing-field", "seeds-in"],
+    ["regularity", "seeds-in"],
+    ["regularity", "spacing-field"],
 ];
 
 /// The short forms of long options, to tell whether the command line gave one.

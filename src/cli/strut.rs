@@ -2,7 +2,7 @@
 
 use super::command::{job, parsed, Command, PartKeys};
 use super::lattice::{
-    human, print_grading, print_part, triple, BoxArgs, GradeArgs, MeshArgs, PartArgs,
+    human, print_density, print_grading, print_part, triple, BoxArgs, GradeArgs, MeshArgs, PartArgs,
 };
 use super::out::outln;
 use super::part::Part;
@@ -280,13 +280,6 @@ fn print_summary(r: &StrutReport) {
         print_part(p);
         return;
     }
-    match p.target_density {
-        Some(t) => outln!(
-            "density   target {t:.4}  achieved {:.4}  (error {:+.5})",
-            p.achieved_density,
-            p.density_error.unwrap_or(f64::NAN)
-        ),
-        None => outln!("density   {:.4}", p.achieved_density),
-    }
+    print_density(p);
     print_part(p);
 }

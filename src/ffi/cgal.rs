@@ -55,6 +55,21 @@ pub(crate) mod ffi {
         inside: Vec<bool>,
     }
 
+    /// The finite part of the Voronoi diagram of points, from their Delaunay triangulation.
+    struct VoronoiDiagram {
+        /// Distinct points triangulated (duplicates merged).
+        seeds_used: u64,
+        /// Voronoi vertices (circumcentres of the finite Delaunay cells), xyz triples.
+        vertices: Vec<f64>,
+        /// Voronoi edges as vertex pairs, flattened.
+        edges: Vec<u32>,
+        /// Per Voronoi face, the two points (input indices) it lies between, flattened.
+        face_seeds: Vec<u32>,
+        /// Per face, the range of `face_vertices` holding its polygon (CSR).
+        face_starts: Vec<u32>,
+        face_vertices: Vec<u32>,
+    }
+
     unsafe extern "C++" {
         include!("latvox/cpp/cgal.h");
 
@@ -103,5 +118,8 @@ pub(crate) mod ffi {
         /// against it travels before it meets another facet (the nearer; infinity if neither
         /// does): the wall's thickness or the gap in front of it.
         fn cgal_facet_reach(positions: &[f32], indices: &[u32]) -> Result<Vec<f64>>;
+
+        /// The finite Voronoi diagram of `points` (xyz triples).
+        fn cgal_voronoi(points: &[f64]) -> Result<VoronoiDiagram>;
     }
 }

@@ -1,7 +1,7 @@
 //! Where Rust calls C++: one bridge per library, [`vdb`] (OpenVDB, `cpp/vdb.h`) and [`cgal`]
 //! (CGAL, `cpp/cgal.h`), each header implemented by a few small translation units, none of which
 //! parses both libraries' headers. Nothing here is public, and no `cxx` type leaves this module:
-//! safe wrappers live in `grid`, `verify::cgal` and `repair::cgal`.
+//! safe wrappers live in `grid`, `verify::cgal`, `repair::cgal` and `lattice::voronoi::diagram`.
 
 pub(crate) mod cgal;
 pub(crate) mod vdb;

@@ -138,7 +138,7 @@ pub struct BeamField {
 }
 
 /// Distance from `p` to the segment `ab`.
-fn segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f64 {
+pub fn segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f64 {
     let ab = sub(b, a);
     let ap = sub(p, a);
     let l2 = dot(ab, ab);

@@ -614,6 +614,58 @@ pub struct Solved {
     pub meshing: MeshingStats,
 }
 
+/// A part found at one resolution: its voxel, route, the part at its level and the search.
+pub struct Found {
+    /// Voxel edge, mm.
+    pub voxel: f64,
+    /// How it is meshed.
+    pub route: Route,
+    /// The part at the level found (or given).
+    pub best: Measured,
+    /// Levels meshed and the fraction each gave, in order.
+    pub tried: Vec<(f64, f64)>,
+    /// Meshing statistics of the search.
+    pub meshing: MeshingStats,
+}
+
+/// The part on voxels of `voxel` on `route`: at the level that gives `target` (the closest
+/// fraction found when none does, as `Err`), or measured at `level` when there is no target —
+/// one attempt of a resolution search ([`crate::mesh::resolution::search`]).
+pub fn find<F: Family>(
+    family: &F,
+    target: Option<f64>,
+    level: f64,
+    voxel: f64,
+    route: Route,
+    o: &Options,
+) -> Result<std::result::Result<Found, f64>> {
+    Ok(match target {
+        Some(d) => {
+            let solved = solve(family, d, level, voxel, route, o)?;
+            if !solved.met {
+                return Ok(Err(solved.best.fraction));
+            }
+            Ok(Found {
+                voxel,
+                route,
+                best: solved.best,
+                tried: solved.tried,
+                meshing: solved.meshing,
+            })
+        }
+        None => {
+            let best = measure(family, level, voxel, route, o)?;
+            Ok(Found {
+                voxel,
+                route,
+                tried: vec![(level, best.fraction)],
+                meshing: best.meshing,
+                best,
+            })
+        }
+    })
+}
+
 /// Finds the level at which the part's measured volume fraction is `target`, starting from
 /// `start`: each step reads the next level off the family's model at the target less the
 /// difference between measured and modelled fraction (the meshing's and the box's effect, which

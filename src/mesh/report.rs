@@ -117,6 +117,31 @@ pub struct PartReport {
 }
 
 impl PartReport {
+    /// [`PartReport::new`] for a part written after a resolution search: the search's warning
+    /// (the resolution raised) first, the total time since `start`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn after_search(
+        bounds: Aabb,
+        target: Option<f64>,
+        route: Route,
+        written: Written,
+        search: MeshingStats,
+        calibrate: f64,
+        raised: Option<String>,
+        start: std::time::Instant,
+    ) -> PartReport {
+        let timings = Timings {
+            calibrate,
+            ..Timings::default()
+        };
+        let mut part = PartReport::new(bounds, target, route, written, search, timings);
+        let mut warnings: Vec<String> = raised.into_iter().collect();
+        warnings.append(&mut part.warnings);
+        part.warnings = warnings;
+        part.timings.total = start.elapsed().as_secs_f64();
+        part
+    }
+
     /// The report of the part `written` on `route` in `bounds`, made to `target` (if any):
     /// `search` holds the meshings that found its level, `timings` the capability's own
     /// (calibration, total) — the meshing's are filled in here, and the warnings of the written

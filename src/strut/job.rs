@@ -11,8 +11,8 @@ use crate::geom::Mesh;
 use crate::io::sink::{MeshCollector, MeshSink};
 use crate::io::threemf::BeamModel;
 use crate::mesh::graded::{Grading, GradingReport};
-use crate::mesh::pipeline::{self, Family, Measured, MeshingStats, Options, Route};
-use crate::mesh::report::{LevelSearch, PartReport, Timings};
+use crate::mesh::pipeline::{self, Family, Found, Options, Route};
+use crate::mesh::report::{LevelSearch, PartReport};
 use crate::mesh::resolution::{self, max_resolution, Resolved};
 use crate::progress::Progress;
 use crate::verify::Verdict;
@@ -164,15 +164,6 @@ impl BeamsReport {
     }
 }
 
-/// A resolution at which the part was found: its voxel, route and the part measured.
-struct Found {
-    voxel: f64,
-    route: Route,
-    best: Measured,
-    tried: Vec<(f64, f64)>,
-    meshing: MeshingStats,
-}
-
 impl StrutJob {
     fn validate(&self) -> Result<()> {
         match self.sizing {
@@ -314,32 +305,7 @@ impl StrutJob {
             });
             let voxel = self.voxel(r);
             let route = Route::choose(&family.at(r0), voxel, opts);
-            Ok(match target {
-                Some(d) => {
-                    let solved = pipeline::solve(family, d, r0, voxel, route, opts)?;
-                    if solved.met {
-                        Ok(Found {
-                            voxel,
-                            route,
-                            best: solved.best,
-                            tried: solved.tried,
-                            meshing: solved.meshing,
-                        })
-                    } else {
-                        Err(solved.best.fraction)
-                    }
-                }
-                None => {
-                    let best = pipeline::measure(family, r0, voxel, route, opts)?;
-                    Ok(Found {
-                        voxel,
-                        route,
-                        tried: vec![(r0, best.fraction)],
-                        meshing: best.meshing,
-                        best,
-                    })
-                }
-            })
+            pipeline::find(family, target, r0, voxel, route, opts)
         })
     }
 
@@ -363,21 +329,16 @@ impl StrutJob {
         let level_search = LevelSearch::new(&best, route, &tried, resolved.coarser);
         let opts = &self.options;
         let written = pipeline::write(&family, best, voxel, route, opts, progress, sink)?;
-        let mut part = PartReport::new(
+        let part = PartReport::after_search(
             self.domain.bounds(),
             self.target(),
             route,
             written,
             meshing,
-            Timings {
-                calibrate: model_seconds,
-                ..Timings::default()
-            },
+            model_seconds,
+            resolved.raised,
+            start,
         );
-        let mut warnings: Vec<String> = resolved.raised.into_iter().collect();
-        warnings.append(&mut part.warnings);
-        part.warnings = warnings;
-        part.timings.total = start.elapsed().as_secs_f64();
         Ok(StrutReport {
             cell: self.cell_name.clone(),
             cell_nodes: self.cell.nodes.len(),

@@ -10,7 +10,7 @@
 //!
 //! Seeded: a failure names its case N, and `LATVOX_CASE=N` runs that case alone. The main tier
 //! runs the first 20 of a hundred fast cases; the long tier (`cargo test --release --
-//! --ignored density_property`) all hundred, and 150 over the whole feasible range (`LATVOX_SWEEP=
+//! --ignored density_property`) all hundred, and 60 over the whole feasible range (`LATVOX_SWEEP=
 //! 1000`: a thousand).
 
 use crate::common::*;
@@ -272,7 +272,7 @@ fn every_random_setting_meets_the_density_or_names_a_resolution_that_does() {
     property(0x1a7_0c5, 100, false);
 }
 
-/// The sweep over the whole feasible range: the first 150 of its thousand cases in the long
+/// The sweep over the whole feasible range: the first 60 of its thousand cases in the long
 /// tier (a few minutes), all thousand with `LATVOX_SWEEP=1000` (about half an hour on two cores).
 #[test]
 #[ignore = "long: random settings over the whole feasible range (LATVOX_SWEEP=1000: a thousand)"]
@@ -280,7 +280,7 @@ fn settings_over_the_whole_feasible_range() {
     let cases = std::env::var("LATVOX_SWEEP")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(150);
+        .unwrap_or(60);
     property(0x5eed_2026, cases, true);
 }
 

@@ -40,3 +40,4 @@ mod tiling;
 mod topopt;
 mod tpms_cli;
 mod view;
+mod voronoi;

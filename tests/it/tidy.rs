@@ -35,7 +35,7 @@ const STAGES: [&str; 12] = [
 ];
 
 /// The capabilities: each uses the base and the stages only.
-const CAPABILITIES: [&str; 8] = [
+const CAPABILITIES: [&str; 9] = [
     "tpms",
     "strut",
     "fill",
@@ -43,6 +43,7 @@ const CAPABILITIES: [&str; 8] = [
     "interpret",
     "topopt",
     "homogenize",
+    "voronoi",
     "batch",
 ];
 

@@ -5,6 +5,7 @@ use super::cell::UnitCell;
 use super::field::StrutField;
 use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
+use crate::lattice::model::LevelModel;
 use crate::mesh::pipeline::{Family, Solid};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -72,10 +73,8 @@ impl Solid for StrutLattice {
 /// strictly. The pipeline steps the radius through it and corrects it on the meshed part.
 #[derive(Debug, Clone)]
 pub struct RadiusModel {
-    /// The radius at which each point is held, sorted.
-    radii: Vec<f64>,
-    /// A radius at which every point is held.
-    max_radius: f64,
+    /// The fraction held against the radius (points held at their distance to a strut axis).
+    radii: LevelModel,
     /// The radius at which the pores close: the void stops running through the lattice from
     /// cell to cell (at and above it, powder or resin is trapped).
     pub closing: f64,
@@ -212,7 +211,7 @@ impl RadiusModel {
         // No point of the cell is farther than half its diagonal from a node.
         let field = AxisDistance::new(cell, size);
         let n = MODEL_POINTS;
-        let mut radii: Vec<f64> = (0..n * n * n)
+        let radii: Vec<f64> = (0..n * n * n)
             .into_par_iter()
             .map(|i| {
                 // One point in each of n³ strata, offset inside it by an additive recurrence
@@ -226,55 +225,23 @@ impl RadiusModel {
                 field.axis_distance(p)
             })
             .collect();
-        radii.sort_by(f64::total_cmp);
         let diagonal = size.iter().map(|s| s * s).sum::<f64>().sqrt();
-        let max_radius = radii.last().copied().unwrap_or(diagonal) * (1.0 + 1e-9) + 1e-12;
         let closing = closing_radius(&field, size, CLOSING_POINTS);
         RadiusModel {
-            radii,
-            max_radius,
+            radii: LevelModel::new(radii, diagonal),
             closing,
         }
     }
 
     /// The fraction of the cell the lattice fills at radius `r`.
     pub fn fraction(&self, r: f64) -> f64 {
-        let n = self.radii.len();
-        if r <= 0.0 {
-            return 0.0;
-        }
-        if r >= self.max_radius {
-            return 1.0;
-        }
-        // Points held at r: radii[k] ≤ r for k < count; interpolate to the next.
-        let count = self.radii.partition_point(|&x| x <= r);
-        let below = if count == 0 {
-            0.0
-        } else {
-            self.radii[count - 1]
-        };
-        let above = self.radii.get(count).copied().unwrap_or(self.max_radius);
-        let t = if above > below {
-            (r - below) / (above - below)
-        } else {
-            0.0
-        };
-        ((count as f64 + t) / (n as f64 + 1.0)).clamp(0.0, 1.0)
+        self.radii.fraction(r)
     }
 
     /// The radius at which the lattice fills `fraction` of the cell (the inverse of
     /// [`RadiusModel::fraction`]).
     pub fn radius(&self, fraction: f64) -> f64 {
-        let (mut lo, mut hi) = (0.0, self.max_radius);
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if self.fraction(mid) < fraction {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        0.5 * (lo + hi)
+        self.radii.level(fraction)
     }
 }
 

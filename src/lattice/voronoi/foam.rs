@@ -1,0 +1,511 @@
+//! A Voronoi foam as a family of solids for the pipeline: the level is the strut radius of a net
+//! or the wall thickness of a sheet.
+//!
+//! **Net.** Every Voronoi edge near the box is a capsule of the radius ([`BeamField`]: exact
+//! distance to the edges, minus the radius).
+//!
+//! **Sheet.** For a point `p` in the cell of seed `s₁`, its distance to the cell's boundary — to
+//! the nearest Voronoi face — is the least distance to the bisector planes of `s₁` and the other
+//! seeds, `(|p − sⱼ|² − |p − s₁|²) / (2 |sⱼ − s₁|)`: a convex cell is the intersection of those
+//! half spaces, and a redundant plane lies outside the cell, never nearer. Only seeds with
+//! `|p − sⱼ| ≤ |p − s₁| + 2D` can give a distance under `D` (the plane is at least half the
+//! difference of the two distances away), so a kd-tree query of that radius finds them all. The
+//! wall is where that distance is under half the thickness; its field is exact, 1-Lipschitz.
+//!
+//! The density model samples points through the box and the level at which each is held
+//! ([`LevelModel`]). The largest level keeps the pores open. A net's window shuts when the struts
+//! round it reach its centroid (its inradius, from the centroid); half the windows in the box
+//! may shut, no more: each cell keeps several windows on average and the void runs through the
+//! foam. A sheet's cells are closed by their walls; the walls may be as thick as half the
+//! distance from a seed to its nearest face, leaving nine cells in ten a void at least half that
+//! size.
+
+use super::diagram::Voronoi;
+use super::seeds::Rng;
+use crate::error::{Error, Result};
+use crate::field::beams::{segment_distance, Beam, BeamField, Cap};
+use crate::field::{Aabb, Field, Vec3};
+use crate::grid::GridSpec;
+use crate::lattice::model::LevelModel;
+use crate::mesh::pipeline::{Family, Solid};
+use kiddo::{KdTree, SquaredEuclidean};
+use std::sync::Arc;
+
+/// Points of the density model.
+const MODEL_POINTS: usize = 1 << 16;
+
+/// What the foam's members are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Structure {
+    /// Struts along the Voronoi edges.
+    Net,
+    /// Walls along the Voronoi faces.
+    Sheet,
+}
+
+impl Structure {
+    /// The name of its level, for messages: "radius" or "thickness".
+    pub fn level_name(self) -> &'static str {
+        match self {
+            Structure::Net => "radius",
+            Structure::Sheet => "thickness",
+        }
+    }
+}
+
+/// Mean, spread and extremes of a set of lengths, mm.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct Spread {
+    /// How many.
+    pub count: usize,
+    /// Mean.
+    pub mean: f64,
+    /// 5th percentile.
+    pub p5: f64,
+    /// 95th percentile.
+    pub p95: f64,
+    /// Smallest.
+    pub min: f64,
+    /// Largest.
+    pub max: f64,
+}
+
+impl Spread {
+    /// The spread of `values`.
+    pub fn of(mut values: Vec<f64>) -> Spread {
+        values.retain(|v| v.is_finite());
+        if values.is_empty() {
+            return Spread::default();
+        }
+        values.sort_by(f64::total_cmp);
+        let at = |q: f64| {
+            values[((q * (values.len() - 1) as f64).round() as usize).min(values.len() - 1)]
+        };
+        Spread {
+            count: values.len(),
+            mean: values.iter().sum::<f64>() / values.len() as f64,
+            p5: at(0.05),
+            p95: at(0.95),
+            min: values[0],
+            max: values[values.len() - 1],
+        }
+    }
+}
+
+/// The foam's diagram, measured.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct FoamStats {
+    /// Seeds the diagram was made of (the box and a margin round it).
+    pub seeds: usize,
+    /// Cells in the box: seeds inside it.
+    pub cells: usize,
+    /// Equivalent diameters of the cells in the box (a ball of the cell's volume), mm.
+    pub cell_diameter: Spread,
+    /// Lengths of the Voronoi edges whose middle is in the box, mm (after edges shorter than
+    /// the merge length were merged away).
+    pub edge_length: Spread,
+    /// Voronoi edges merged away as shorter than the merge length.
+    pub edges_merged: usize,
+}
+
+/// A Voronoi foam in a box.
+pub struct Foam {
+    /// Struts or walls.
+    pub structure: Structure,
+    /// The part's box.
+    pub bounds: Aabb,
+    /// The diagram, its short edges merged.
+    pub diagram: Voronoi,
+    /// The edges that can reach into the box.
+    segments: Vec<[Vec3; 2]>,
+    /// The seeds, for the walls' field.
+    tree: KdTree<f64, 3>,
+    /// Volume fraction against the level.
+    pub model: LevelModel,
+    /// The largest level at which the pores stay open.
+    pub closing: f64,
+    /// The diagram measured.
+    pub stats: FoamStats,
+    /// How far beyond the box a member may matter, mm.
+    reach: f64,
+}
+
+impl std::fmt::Debug for Foam {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Foam")
+            .field("structure", &self.structure)
+            .field("bounds", &self.bounds)
+            .field("stats", &self.stats)
+            .finish()
+    }
+}
+
+fn sub(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn norm(a: Vec3) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+impl Foam {
+    /// The foam of `seeds` (which should fill `bounds` and a margin of a few spacings round it)
+    /// in `bounds`, edges shorter than `merge` mm merged; `reach` is how far beyond the box a
+    /// member may matter (its largest radius or half thickness and the narrow band).
+    pub fn new(
+        structure: Structure,
+        bounds: Aabb,
+        seeds: Vec<Vec3>,
+        merge: f64,
+        reach: f64,
+    ) -> Result<Foam> {
+        if seeds.iter().filter(|s| bounds.contains(**s)).count() == 0 {
+            return Err(Error::invalid(
+                "no seed lies in the box: the foam has no cell there",
+            ));
+        }
+        let raw = Voronoi::of(&seeds)?;
+        let diagram = raw.merged(merge);
+        let near = bounds.grown(reach);
+        let segments: Vec<[Vec3; 2]> = diagram
+            .edges
+            .iter()
+            .map(|&[a, b]| [diagram.vertices[a as usize], diagram.vertices[b as usize]])
+            .filter(|[a, b]| {
+                let lo = [0, 1, 2].map(|k| a[k].min(b[k]));
+                let hi = [0, 1, 2].map(|k| a[k].max(b[k]));
+                (0..3).all(|k| lo[k] <= near.max[k] && hi[k] >= near.min[k])
+            })
+            .collect();
+        let mut tree: KdTree<f64, 3> = KdTree::with_capacity(seeds.len());
+        for (i, s) in seeds.iter().enumerate() {
+            tree.add(s, i as u64);
+        }
+        let stats = FoamStats {
+            seeds: seeds.len(),
+            cells: seeds.iter().filter(|s| bounds.contains(**s)).count(),
+            cell_diameter: Spread::of(
+                raw.cell_volumes()
+                    .iter()
+                    .zip(&seeds)
+                    .filter(|(v, s)| **v > 0.0 && bounds.contains(**s))
+                    .map(|(v, _)| (6.0 * v / std::f64::consts::PI).cbrt())
+                    .collect(),
+            ),
+            edge_length: Spread::of(
+                diagram
+                    .edges
+                    .iter()
+                    .map(|&[a, b]| (diagram.vertices[a as usize], diagram.vertices[b as usize]))
+                    .filter(|(a, b)| bounds.contains([0, 1, 2].map(|k| 0.5 * (a[k] + b[k]))))
+                    .map(|(a, b)| norm(sub(a, b)))
+                    .collect(),
+            ),
+            edges_merged: raw.edges.len() - diagram.edges.len(),
+        };
+        let mut foam = Foam {
+            structure,
+            bounds,
+            diagram,
+            segments,
+            tree,
+            model: LevelModel::new(Vec::new(), 1.0),
+            closing: 0.0,
+            stats,
+            reach,
+        };
+        foam.model = foam.measure_model();
+        foam.closing = foam.closing_level();
+        Ok(foam)
+    }
+
+    /// The seeds.
+    pub fn seeds(&self) -> &[Vec3] {
+        &self.diagram.seeds
+    }
+
+    /// The edges that reach into the box, as segments.
+    pub fn segments(&self) -> &[[Vec3; 2]] {
+        &self.segments
+    }
+
+    /// The net's struts at `radius` as beams (capsules).
+    pub fn beams(&self, radius: f64) -> Vec<Beam> {
+        self.segments
+            .iter()
+            .map(|&ends| Beam {
+                ends,
+                radii: [radius; 2],
+                caps: [Cap::Sphere; 2],
+            })
+            .collect()
+    }
+
+    /// The net's field at `radius`, exact within `reach` of the struts.
+    pub fn net_field(&self, radius: f64, reach: f64) -> BeamField {
+        BeamField::new(&self.beams(radius), &[], reach)
+    }
+
+    /// The distance from `p` to the nearest Voronoi face, up to `cap`.
+    pub fn face_distance(&self, p: Vec3, cap: f64) -> f64 {
+        let nn = self.tree.nearest_one::<SquaredEuclidean>(&p);
+        let s1 = self.diagram.seeds[nn.item as usize];
+        let a2 = nn.distance;
+        let r = a2.sqrt() + 2.0 * cap;
+        let mut d = cap;
+        for nb in self.tree.within_unsorted::<SquaredEuclidean>(&p, r * r) {
+            if nb.item == nn.item {
+                continue;
+            }
+            let c = norm(sub(self.diagram.seeds[nb.item as usize], s1));
+            if c > 0.0 {
+                d = d.min((nb.distance - a2) / (2.0 * c));
+            }
+        }
+        d.max(0.0)
+    }
+
+    /// The level at which the solid holds the point `p`.
+    fn level_holding(&self, p: Vec3, skeleton: &BeamField) -> f64 {
+        match self.structure {
+            Structure::Net => skeleton.value(p).max(0.0),
+            Structure::Sheet => 2.0 * self.face_distance(p, self.reach),
+        }
+    }
+
+    fn measure_model(&self) -> LevelModel {
+        use rayon::prelude::*;
+        let size = self.bounds.size();
+        let far = self.reach;
+        let skeleton = match self.structure {
+            Structure::Net => self.net_field(0.0, far),
+            Structure::Sheet => BeamField::new(&[], &[], 0.0),
+        };
+        let mut rng = Rng::new(0x5eed);
+        let points: Vec<Vec3> = (0..MODEL_POINTS)
+            .map(|_| [0, 1, 2].map(|k| self.bounds.min[k] + rng.unit() * size[k]))
+            .collect();
+        let levels: Vec<f64> = points
+            .par_iter()
+            .map(|&p| self.level_holding(p, &skeleton))
+            .collect();
+        LevelModel::new(levels, far)
+    }
+
+    /// The largest level at which the pores stay open (see the module's notes).
+    fn closing_level(&self) -> f64 {
+        let d = &self.diagram;
+        let inside = |i: u32| self.bounds.contains(d.seeds[i as usize]);
+        let cells = (0..d.seeds.len() as u32).filter(|&i| inside(i)).count();
+        if cells == 0 {
+            return 0.0;
+        }
+        match self.structure {
+            // Half the windows in the box stay open: a window shuts when the struts round it
+            // reach its centroid (its inradius, from the centroid).
+            Structure::Net => {
+                let mut widths: Vec<f64> = d
+                    .faces
+                    .iter()
+                    .filter_map(|f| {
+                        let pts: Vec<Vec3> =
+                            f.vertices.iter().map(|&v| d.vertices[v as usize]).collect();
+                        let n = pts.len() as f64;
+                        let c = [0, 1, 2].map(|k| pts.iter().map(|p| p[k]).sum::<f64>() / n);
+                        self.bounds.contains(c).then(|| {
+                            (0..pts.len())
+                                .map(|i| segment_distance(c, pts[i], pts[(i + 1) % pts.len()]))
+                                .fold(f64::INFINITY, f64::min)
+                        })
+                    })
+                    .collect();
+                if widths.is_empty() {
+                    return 0.0;
+                }
+                widths.sort_by(f64::total_cmp);
+                widths[widths.len() / 2]
+            }
+            // A cell's void is gone when its walls reach its middle: its nearest face is the
+            // bisector with the nearest other seed, half their distance away; walls half that
+            // thick leave the void at least half its inradius.
+            Structure::Sheet => {
+                let mut open: Vec<f64> = (0..d.seeds.len() as u32)
+                    .filter(|&i| inside(i))
+                    .map(|i| {
+                        let s = d.seeds[i as usize];
+                        self.tree
+                            .nearest_n::<SquaredEuclidean>(&s, 2)
+                            .iter()
+                            .filter(|n| n.item != i as u64)
+                            .map(|n| 0.5 * n.distance.sqrt())
+                            .fold(f64::INFINITY, f64::min)
+                    })
+                    .filter(|x| x.is_finite())
+                    .collect();
+                if open.is_empty() {
+                    return 0.0;
+                }
+                open.sort_by(f64::total_cmp);
+                open[open.len() / 10]
+            }
+        }
+    }
+}
+
+/// A foam at one level, clipped by a box.
+#[derive(Debug, Clone)]
+pub struct FoamSolid {
+    /// The foam.
+    pub foam: Arc<Foam>,
+    /// Strut radius or wall thickness, mm.
+    pub level: f64,
+    /// The clipping box.
+    pub bounds: Aabb,
+}
+
+/// The walls' field: distance to the nearest face minus half the thickness, clamped at `reach`.
+struct SheetField<'a> {
+    foam: &'a Foam,
+    half: f64,
+    reach: f64,
+}
+
+impl SheetField<'_> {
+    /// Values at `points`, all within `spread` of `centre`: the seeds that can matter to any
+    /// of them found once.
+    fn values_near(&self, centre: Vec3, spread: f64, points: &[Vec3], out: &mut [f64]) {
+        let tree = &self.foam.tree;
+        let seeds = &self.foam.diagram.seeds;
+        let cap = self.half + self.reach;
+        let a = tree
+            .nearest_one::<SquaredEuclidean>(&centre)
+            .distance
+            .sqrt();
+        let r = a + 2.0 * spread + 2.0 * cap;
+        let near: Vec<Vec3> = tree
+            .within_unsorted::<SquaredEuclidean>(&centre, r * r)
+            .iter()
+            .map(|n| seeds[n.item as usize])
+            .collect();
+        let d2 = |p: Vec3, s: Vec3| (0..3).map(|k| (p[k] - s[k]).powi(2)).sum::<f64>();
+        for (p, o) in points.iter().zip(out.iter_mut()) {
+            let (mut best, mut i1) = (f64::INFINITY, 0);
+            for (i, s) in near.iter().enumerate() {
+                let d = d2(*p, *s);
+                if d < best {
+                    best = d;
+                    i1 = i;
+                }
+            }
+            let s1 = near[i1];
+            let mut d = cap;
+            for (i, s) in near.iter().enumerate() {
+                if i != i1 {
+                    let c = d2(*s, s1).sqrt();
+                    if c > 0.0 {
+                        d = d.min((d2(*p, *s) - best) / (2.0 * c));
+                    }
+                }
+            }
+            *o = (d - self.half).min(self.reach);
+        }
+    }
+}
+
+impl Field for SheetField<'_> {
+    fn value(&self, p: Vec3) -> f64 {
+        (self.foam.face_distance(p, self.half + self.reach) - self.half).min(self.reach)
+    }
+
+    fn clearance(&self, p: Vec3) -> f64 {
+        self.value(p).abs()
+    }
+
+    fn values(&self, points: &[Vec3], out: &mut [f64]) {
+        if points.is_empty() {
+            return;
+        }
+        let n = points.len() as f64;
+        let c = [0, 1, 2].map(|k| points.iter().map(|p| p[k]).sum::<f64>() / n);
+        let spread = points.iter().map(|p| norm(sub(*p, c))).fold(0.0, f64::max);
+        self.values_near(c, spread, points, out);
+    }
+
+    fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
+        let mut points = Vec::with_capacity(512);
+        for i in 0..8 {
+            for j in 0..8 {
+                for k in 0..8 {
+                    points.push([
+                        origin[0] + h * i as f64,
+                        origin[1] + h * j as f64,
+                        origin[2] + h * k as f64,
+                    ]);
+                }
+            }
+        }
+        let c = origin.map(|x| x + 3.5 * h);
+        let mut values = [0.0; 512];
+        self.values_near(c, 3.5 * h * 3f64.sqrt(), &points, &mut values);
+        for (o, v) in out.iter_mut().zip(values) {
+            *o = v as f32;
+        }
+    }
+}
+
+impl Solid for FoamSolid {
+    fn field(&self, spec: &GridSpec) -> Box<dyn Field + '_> {
+        let reach = spec.half_width * spec.voxel;
+        match self.foam.structure {
+            Structure::Net => Box::new(self.foam.net_field(self.level, reach)),
+            Structure::Sheet => Box::new(SheetField {
+                foam: &self.foam,
+                half: 0.5 * self.level,
+                reach,
+            }),
+        }
+    }
+
+    fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    fn with_bounds(&self, bounds: Aabb) -> Self {
+        FoamSolid {
+            bounds,
+            ..self.clone()
+        }
+    }
+
+    fn period(&self) -> Option<Vec3> {
+        None
+    }
+}
+
+/// A foam at every level.
+#[derive(Debug, Clone)]
+pub struct FoamFamily {
+    /// The foam.
+    pub foam: Arc<Foam>,
+}
+
+impl Family for FoamFamily {
+    type Solid = FoamSolid;
+
+    fn at(&self, level: f64) -> FoamSolid {
+        FoamSolid {
+            foam: self.foam.clone(),
+            level,
+            bounds: self.foam.bounds,
+        }
+    }
+
+    fn model_fraction(&self, level: f64) -> f64 {
+        self.foam.model.fraction(level)
+    }
+
+    fn model_level(&self, fraction: f64) -> f64 {
+        self.foam.model.level(fraction)
+    }
+}

@@ -1,0 +1,480 @@
+//! One Voronoi-foam job, start to finish: seed the box and a margin round it, compute the
+//! diagram (CGAL), refuse a level at which the pores close, find the strut radius or wall
+//! thickness that gives *this* part its density (or take the one given) — raising the
+//! resolution when members would be under [`MIN_STRUT_VOXELS`] across — then mesh, verify,
+//! write and report, with the foam's cells and edges measured. The meshing is
+//! [`crate::mesh::pipeline`]'s, the resolution search [`crate::mesh::resolution`]'s.
+
+use crate::error::{Error, Result};
+use crate::field::density::DensityField;
+use crate::field::{Aabb, Vec3};
+use crate::geom::Mesh;
+use crate::io::sink::{MeshCollector, MeshSink};
+use crate::lattice::strut::MIN_STRUT_VOXELS;
+use crate::lattice::voronoi::{seeds, Foam, FoamFamily, FoamStats, Structure};
+use crate::mesh::pipeline::{self, Family, Found, Options, Route};
+use crate::mesh::report::{LevelSearch, PartReport};
+use crate::mesh::resolution::{self, max_resolution, Resolved};
+use crate::progress::Progress;
+use crate::verify::Verdict;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// How thick the members are: made to a volume fraction, or given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Sizing {
+    /// The strut radius or wall thickness that gives the written part this volume fraction.
+    Density(f64),
+    /// This strut radius (net) or wall thickness (sheet), mm.
+    Level(f64),
+}
+
+/// The mean spacing of the seeds (the edge of the mean cell), mm.
+#[derive(Clone)]
+pub enum Spacing {
+    /// The same everywhere.
+    Uniform(f64),
+    /// A field over the box.
+    Field(Arc<DensityField>),
+}
+
+impl Spacing {
+    /// The spacing at `p`.
+    pub fn at(&self, p: Vec3) -> f64 {
+        match self {
+            Spacing::Uniform(s) => *s,
+            Spacing::Field(f) => f.at(p, 0.0),
+        }
+    }
+}
+
+/// Where the seeds come from.
+#[derive(Clone)]
+pub enum Seeding {
+    /// Poisson-disk points at a spacing, moved toward the BCC lattice by a regularity.
+    Poisson {
+        /// The spacing.
+        spacing: Spacing,
+        /// The generator's seed.
+        seed: u64,
+        /// 0 (random) to 1 (the Kelvin foam).
+        regularity: f64,
+    },
+    /// The user's points.
+    Given(Vec<Vec3>),
+}
+
+/// What to build.
+#[derive(Clone)]
+pub struct VoronoiJob {
+    /// Struts or walls.
+    pub structure: Structure,
+    /// The seeds.
+    pub seeding: Seeding,
+    /// Density or member size.
+    pub sizing: Sizing,
+    /// The part's box.
+    pub bounds: Aabb,
+    /// Voxels per spacing (the smallest, where it varies).
+    pub resolution: u32,
+    /// Raise the resolution when members would be too thin for the voxels.
+    pub auto_resolution: bool,
+    /// The pipeline's options.
+    pub options: Options,
+}
+
+/// The member sizes (and densities) the foam allows.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct VoronoiRange {
+    /// The thinnest members, [`MIN_STRUT_VOXELS`] across at the resolution used: a strut
+    /// radius or a wall thickness, mm.
+    pub min_level: f64,
+    /// The size at which the pores close.
+    pub max_level: f64,
+    /// The foam's volume fraction at `min_level` (its model's).
+    pub min_density: f64,
+    /// The foam's volume fraction at `max_level` (its model's).
+    pub max_density: f64,
+}
+
+/// The JSON report of a Voronoi job.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct VoronoiReport {
+    /// `net` or `sheet`.
+    pub structure: Structure,
+    /// Where the seeds came from: `poisson` or `file`.
+    pub seeding: &'static str,
+    /// The generator's seed (Poisson seeds).
+    pub seed: Option<u64>,
+    /// How far the seeds were moved toward the BCC lattice, 0 to 1.
+    pub regularity: f64,
+    /// The mean spacing (edge of the mean cell), least and greatest through the box, mm.
+    pub spacing: [f64; 2],
+    /// Strut radius of a net, mm.
+    pub radius: Option<f64>,
+    /// Wall thickness of a sheet, mm.
+    pub thickness: Option<f64>,
+    /// The members, voxels across.
+    pub member_voxels: f64,
+    /// What the foam allows.
+    pub feasible_range: VoronoiRange,
+    /// How the level was found.
+    pub level_search: LevelSearch,
+    /// Voxels per spacing asked for.
+    pub resolution_requested: u32,
+    /// Voxels per spacing used.
+    pub resolution: u32,
+    /// Voxel edge, mm.
+    pub voxel_size: f64,
+    /// The diagram: cells, their sizes, edge lengths.
+    pub foam: FoamStats,
+    /// The part as written.
+    #[serde(flatten)]
+    pub part: PartReport,
+    /// The seeds the diagram was made of (box and margin), for `--seeds-out`.
+    #[serde(skip)]
+    pub seeds: Vec<Vec3>,
+}
+
+impl VoronoiReport {
+    /// The part's verdict.
+    pub fn verdict(&self) -> Verdict {
+        self.part.verdict()
+    }
+}
+
+/// Points of the grid the spacing field is checked on, per axis.
+const SPACING_PROBES: usize = 17;
+
+impl VoronoiJob {
+    fn validate(&self) -> Result<()> {
+        match self.sizing {
+            Sizing::Density(d) => resolution::check_density(d)?,
+            Sizing::Level(l) if !(l > 0.0 && l.is_finite()) => {
+                let name = self.structure.level_name();
+                return Err(Error::setting(
+                    name,
+                    format!("{name} must be a positive length in mm, got {l}"),
+                ));
+            }
+            _ => {}
+        }
+        if let Seeding::Poisson { regularity, .. } = self.seeding {
+            if !(0.0..=1.0).contains(&regularity) {
+                return Err(Error::setting(
+                    "regularity",
+                    format!("regularity must be in [0, 1], got {regularity}"),
+                ));
+            }
+        }
+        let s = self.bounds.size();
+        if !s.iter().all(|x| *x > 0.0 && x.is_finite()) {
+            return Err(Error::invalid("the box must have a positive size"));
+        }
+        resolution::check_resolution(self.resolution)
+    }
+
+    /// The least and greatest spacing through the box.
+    fn spacing_range(&self) -> Result<[f64; 2]> {
+        match &self.seeding {
+            Seeding::Poisson { spacing, .. } => {
+                let n = SPACING_PROBES;
+                let size = self.bounds.size();
+                let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+                for i in 0..n * n * n {
+                    let c = [i / (n * n), (i / n) % n, i % n];
+                    let p = [0, 1, 2]
+                        .map(|k| self.bounds.min[k] + size[k] * c[k] as f64 / (n - 1) as f64);
+                    let s = spacing.at(p);
+                    if !(s > 0.0 && s.is_finite()) {
+                        return Err(Error::setting(
+                            "spacing",
+                            format!(
+                                "the spacing must be a positive length in mm everywhere in the box, got {s} at ({:.3}, {:.3}, {:.3})",
+                                p[0], p[1], p[2]
+                            ),
+                        ));
+                    }
+                    lo = lo.min(s);
+                    hi = hi.max(s);
+                }
+                Ok([lo, hi])
+            }
+            Seeding::Given(points) => {
+                let inside = points.iter().filter(|p| self.bounds.contains(**p)).count();
+                if inside == 0 {
+                    return Err(Error::invalid(
+                        "no seed lies in the box: move the box (--origin, --size) onto the seeds",
+                    ));
+                }
+                let s = (self.bounds.volume() / inside as f64).cbrt();
+                Ok([s, s])
+            }
+        }
+    }
+
+    /// The seeds: the box and a margin of two spacings round it, so that the cells reaching
+    /// into the box are whole.
+    fn seeds(&self, spacing: [f64; 2]) -> Result<Vec<Vec3>> {
+        match &self.seeding {
+            Seeding::Given(points) => Ok(points.clone()),
+            Seeding::Poisson {
+                spacing: field,
+                seed,
+                regularity,
+            } => {
+                let region = self.bounds.grown(2.0 * spacing[1]);
+                seeds::check_count(region.volume(), spacing[0])?;
+                // Beyond the box the spacing is the nearest point of the box's.
+                let clamp =
+                    |p: Vec3| [0, 1, 2].map(|k| p[k].clamp(self.bounds.min[k], self.bounds.max[k]));
+                let points = seeds::poisson(&region, &|p| field.at(clamp(p)), *seed);
+                Ok(match field {
+                    Spacing::Uniform(s) if *regularity > 0.0 => {
+                        seeds::regularise(&points, &region, *s, *regularity, *seed)
+                    }
+                    _ => points,
+                })
+            }
+        }
+    }
+
+    /// The voxel edge at `resolution` voxels per spacing.
+    fn voxel(spacing: [f64; 2], resolution: u32) -> f64 {
+        spacing[0] / resolution as f64
+    }
+
+    /// The thinnest member (a radius or a thickness), [`MIN_STRUT_VOXELS`] across.
+    fn min_level(&self, voxel: f64) -> f64 {
+        match self.structure {
+            Structure::Net => 0.5 * MIN_STRUT_VOXELS * voxel,
+            Structure::Sheet => MIN_STRUT_VOXELS * voxel,
+        }
+    }
+
+    /// Voxels across a member of `level`.
+    fn across(&self, level: f64, voxel: f64) -> f64 {
+        match self.structure {
+            Structure::Net => 2.0 * level / voxel,
+            Structure::Sheet => level / voxel,
+        }
+    }
+
+    fn setting(&self) -> String {
+        match self.sizing {
+            Sizing::Density(d) => format!("density {d}"),
+            Sizing::Level(l) => format!("{} {l} mm", self.structure.level_name()),
+        }
+    }
+
+    fn name(&self) -> String {
+        format!(
+            "the Voronoi {}",
+            match self.structure {
+                Structure::Net => "net",
+                Structure::Sheet => "sheet",
+            }
+        )
+    }
+
+    fn range(&self, foam: &Foam, voxel: f64) -> VoronoiRange {
+        let min_level = self.min_level(voxel);
+        VoronoiRange {
+            min_level,
+            max_level: foam.closing,
+            min_density: foam.model.fraction(min_level),
+            max_density: foam.model.fraction(foam.closing),
+        }
+    }
+
+    /// Refuses a level or density at which the pores close (or, with none open, any).
+    fn refuse_closed(&self, foam: &Foam, level: f64, voxel: f64, resolution: u32) -> Result<()> {
+        if level < foam.closing {
+            return Ok(());
+        }
+        let range = self.range(foam, voxel);
+        let name = self.structure.level_name();
+        let (setting, value, min, max) = match self.sizing {
+            Sizing::Density(d) => ("density", d, range.min_density, range.max_density),
+            Sizing::Level(l) => (name, l, range.min_level, range.max_level),
+        };
+        Err(Error::Infeasible {
+            setting: setting.into(),
+            value,
+            min,
+            max,
+            message: format!(
+                "{} at {} closes its pores: at {name} {:.4} mm (density {:.3}) {}; it can be built at {name} {:.4} to {:.4} mm, density {:.3} to {:.3} (at {resolution} voxels per spacing)",
+                self.name(),
+                self.setting(),
+                range.max_level,
+                range.max_density,
+                match self.structure {
+                    Structure::Net => "half the windows between its cells are shut",
+                    Structure::Sheet => "the walls fill over half the void of one cell in ten",
+                },
+                range.min_level,
+                range.max_level,
+                range.min_density,
+                range.max_density,
+            ),
+        })
+    }
+
+    /// The resolution members of `level` need when the requested one leaves them thinner than
+    /// [`MIN_STRUT_VOXELS`], and why; refused when even the finest searched would not do.
+    fn thin(&self, level: f64, spacing: [f64; 2]) -> Result<Option<(u32, String)>> {
+        let req = self.resolution;
+        let across = self.across(level, Self::voxel(spacing, req));
+        if across >= MIN_STRUT_VOXELS {
+            return Ok(None);
+        }
+        let needed = (req as f64 * MIN_STRUT_VOXELS / across).ceil() as u32;
+        let why = format!("members were {across:.2} voxels across at {req} voxels per spacing");
+        if self.auto_resolution && needed > max_resolution(req) {
+            let name = self.structure.level_name();
+            return Err(Error::Resolution {
+                requested: req,
+                needed: Some(needed),
+                message: format!(
+                    "{} at {}: {why}, and would need {needed} voxels per spacing; give a larger {name} or density (at {req} voxels per spacing: {name} ≥ {:.4} mm), or --resolution {needed}",
+                    self.name(),
+                    self.setting(),
+                    self.min_level(Self::voxel(spacing, req)),
+                ),
+            });
+        }
+        Ok(Some((needed, why)))
+    }
+
+    /// The foam: seeds, diagram and density model.
+    pub fn foam(&self, progress: &Progress) -> Result<(Foam, [f64; 2])> {
+        self.validate()?;
+        let spacing = self.spacing_range()?;
+        let seeds = {
+            let _p = progress.stage("seeding");
+            self.seeds(spacing)?
+        };
+        let _p = progress.stage("computing the Voronoi diagram");
+        let voxel = Self::voxel(spacing, self.resolution);
+        let foam = Foam::new(self.structure, self.bounds, seeds, voxel, spacing[1])?;
+        Ok((foam, spacing))
+    }
+
+    /// Runs the job and returns the mesh with its report.
+    pub fn run(&self, progress: &Progress) -> Result<(Mesh, VoronoiReport)> {
+        let mut collector = MeshCollector::default();
+        let report = self.run_into(progress, &mut collector)?;
+        Ok((collector.mesh, report))
+    }
+
+    /// Runs the job, streaming the part's triangles into `sink`.
+    pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<VoronoiReport> {
+        let start = Instant::now();
+        let (foam, spacing) = self.foam(progress)?;
+        let model_seconds = start.elapsed().as_secs_f64();
+        let family = FoamFamily {
+            foam: Arc::new(foam),
+        };
+        let foam = &family.foam;
+        let voxel0 = Self::voxel(spacing, self.resolution);
+        let l0 = match self.sizing {
+            Sizing::Density(d) => {
+                let range = self.range(foam, voxel0);
+                if d > range.max_density {
+                    // The model's level would close the pores: refuse naming the range.
+                    self.refuse_closed(foam, foam.closing, voxel0, self.resolution)?;
+                }
+                family.model_level(d)
+            }
+            Sizing::Level(l) => l,
+        };
+        self.refuse_closed(foam, l0, voxel0, self.resolution)?;
+        let resolved = self.search(&family, l0, spacing, progress)?;
+        let Found {
+            voxel,
+            route,
+            best,
+            tried,
+            meshing,
+        } = resolved.found;
+        let level = best.level;
+        let level_search = LevelSearch::new(&best, route, &tried, resolved.coarser);
+        let target = match self.sizing {
+            Sizing::Density(d) => Some(d),
+            Sizing::Level(_) => None,
+        };
+        let written = pipeline::write(&family, best, voxel, route, &self.options, progress, sink)?;
+        let part = PartReport::after_search(
+            self.bounds,
+            target,
+            route,
+            written,
+            meshing,
+            model_seconds,
+            resolved.raised,
+            start,
+        );
+        let (seed, regularity) = match self.seeding {
+            Seeding::Poisson {
+                seed, regularity, ..
+            } => (Some(seed), regularity),
+            Seeding::Given(_) => (None, 0.0),
+        };
+        Ok(VoronoiReport {
+            structure: self.structure,
+            seeding: match self.seeding {
+                Seeding::Poisson { .. } => "poisson",
+                Seeding::Given(_) => "file",
+            },
+            seed,
+            regularity,
+            spacing,
+            radius: (self.structure == Structure::Net).then_some(level),
+            thickness: (self.structure == Structure::Sheet).then_some(level),
+            member_voxels: self.across(level, voxel),
+            feasible_range: self.range(foam, voxel),
+            level_search,
+            resolution_requested: self.resolution,
+            resolution: resolved.resolution,
+            voxel_size: voxel,
+            foam: foam.stats,
+            part,
+            seeds: foam.seeds().to_vec(),
+        })
+    }
+
+    /// Finds the resolution and level of the part: the level given, or the one at which the
+    /// part meshes to the target density.
+    fn search(
+        &self,
+        family: &FoamFamily,
+        l0: f64,
+        spacing: [f64; 2],
+        progress: &Progress,
+    ) -> Result<Resolved<Found>> {
+        let target = match self.sizing {
+            Sizing::Density(d) => Some(d),
+            Sizing::Level(_) => None,
+        };
+        let request = resolution::Request {
+            part: self.name(),
+            setting: self.setting(),
+            requested: self.resolution,
+            thin: self.thin(l0, spacing)?,
+            density: target,
+            auto: self.auto_resolution,
+        };
+        let opts = &self.options;
+        resolution::search(&request, &mut |r| {
+            let _p = progress.stage(if r == self.resolution {
+                "finding the member size"
+            } else {
+                "searching for a resolution that reaches the density"
+            });
+            let voxel = Self::voxel(spacing, r);
+            let route = Route::choose(&family.at(l0), voxel, opts);
+            pipeline::find(family, target, l0, voxel, route, opts)
+        })
+    }
+}

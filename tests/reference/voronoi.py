@@ -1,0 +1,77 @@
+"""An independent check of a Voronoi foam: SciPy's Voronoi diagram (Qhull) of the same seeds,
+points sampled on its edges (net) or faces (sheet) well inside the box, and the seeds, each
+classified against the written STL by its generalised winding number (Jacobson et al. 2013,
+the Van Oosterom–Strackee solid angle of every triangle), in NumPy.
+
+usage: voronoi.py SEEDS.csv PART.stl net|sheet LEVEL MARGIN X0 Y0 Z0 X1 Y1 Z1
+  LEVEL: the strut radius or wall thickness; MARGIN: how far inside the box points are taken.
+Prints JSON: the member points and how many lie inside, the seeds and how many lie outside.
+"""
+import json
+import sys
+
+import numpy as np
+from scipy.spatial import Voronoi
+
+
+def read_stl(path):
+    data = open(path, "rb").read()
+    n = int.from_bytes(data[80:84], "little")
+    rec = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    return np.frombuffer(data, dtype=rec, count=n, offset=84)["v"].astype(np.float64)
+
+
+def winding(tris, points):
+    out = []
+    for p in points:
+        a, b, c = tris[:, 0] - p, tris[:, 1] - p, tris[:, 2] - p
+        la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
+        det = np.einsum("ij,ij->i", a, np.cross(b, c))
+        div = (la * lb * lc + np.einsum("ij,ij->i", a, b) * lc
+               + np.einsum("ij,ij->i", b, c) * la + np.einsum("ij,ij->i", c, a) * lb)
+        out.append(np.arctan2(det, div).sum() / (2 * np.pi))
+    return np.array(out)
+
+
+def main():
+    seeds_path, stl, structure, level, margin = sys.argv[1:6]
+    level, margin = float(level), float(margin)
+    box = np.array([float(x) for x in sys.argv[6:12]]).reshape(2, 3)
+    seeds = np.loadtxt(seeds_path, delimiter=",", skiprows=1)
+    vor = Voronoi(seeds)
+    inner = (box[0] + margin, box[1] - margin)
+
+    def within(p):
+        return bool(np.all(p >= inner[0]) and np.all(p <= inner[1]))
+
+    members = []
+    for ridge in vor.ridge_vertices:
+        if -1 in ridge:
+            continue
+        poly = vor.vertices[ridge]
+        if structure == "net":
+            for a, b in zip(poly, np.roll(poly, -1, axis=0)):
+                if np.linalg.norm(b - a) < 4 * margin:
+                    continue
+                for t in (0.3, 0.5, 0.7):
+                    members.append(a + t * (b - a))
+        else:
+            centre = poly.mean(axis=0)
+            members.append(centre)
+            members.extend(centre + 0.5 * (v - centre) for v in poly)
+    members = [p for p in members if within(p)]
+    # One point per member is plenty: keep the test quick.
+    members = np.array(members[: 400])
+    far = np.array([s for s in seeds if within(s)])
+    tris = read_stl(stl)
+    wm = winding(tris, members)
+    wf = winding(tris, far)
+    print(json.dumps({
+        "member_points": int(len(members)),
+        "members_inside": int((wm > 0.5).sum()),
+        "seeds": int(len(far)),
+        "seeds_outside": int((wf < 0.5).sum()),
+    }))
+
+
+main()
