@@ -6,10 +6,11 @@
 //! [`mesh`] (extraction, snapping, tiles, instancing, and the [`mesh::pipeline`] that takes any
 //! clipped field to a verified mesh at its target density) → [`check`] (latvox's checks and
 //! CGAL's) → [`io`] (readers, writers, sinks, atomic output).
-//! Capabilities: [`tpms`], [`repair`] (any mesh file; the STL defects of
-//! Qiao Q., "Key technologies of rapid prototyping from 3D STL models"), [`topopt`] (SIMP
-//! optimiser), [`interpret`] (density fields to printable parts and CAD), [`cad`] (B-spline
-//! curves, IGES, DXF), [`batch`] (many jobs, resumable, sharded over Slurm arrays).
+//! Capabilities: [`tpms`], [`strut`], [`voronoi`] (Voronoi foams), [`repair`] (any mesh file;
+//! the STL defects of Qiao Q., "Key technologies of rapid prototyping from 3D STL models"),
+//! [`topopt`] (SIMP optimiser), [`interpret`] (density fields to printable parts and CAD),
+//! [`cad`] (B-spline curves, IGES, DXF), [`batch`] (many jobs, resumable, sharded over Slurm
+//! arrays).
 //!
 //! # Field → Grid → Mesh
 //!
