@@ -306,6 +306,7 @@ def voronoi(
     density: Optional[Value] = None,
     radius: Optional[Value] = None,
     thickness: Optional[Value] = None,
+    beams: bool = False,
     size: Optional[Value] = None,
     origin: Optional[Value] = None,
     resolution: Optional[Value] = None,
@@ -345,6 +346,8 @@ def voronoi(
     density: Target volume fraction of solid, in (0, 1) (0.15 when no size is given)
     radius: Strut radius of a net, mm, instead of a density
     thickness: Wall thickness of a sheet, mm, instead of a density
+    beams: Write the net as beams (3MF Beam Lattice extension: each Voronoi edge a beam of the
+        radius, the box a clipping mesh) instead of a mesh. The output must be .3mf
     size: Box size in mm: S or SX,SY,SZ (default: 20)
     origin: Lower corner of the box in mm (default: 0,0,0)
     resolution: Voxels per cell along the cell's shortest side (default: 32)

@@ -323,6 +323,27 @@ pub(crate) fn triple(v: [f64; 3]) -> String {
 }
 
 /// The summary's lines on the part written: mesh, bounds, pieces, checks, time, file.
+/// Writes beams to `out` atomically, after checking it is a writable .3mf: `make` gives the
+/// beams once the output is known to be good.
+pub(crate) fn write_beams<R>(
+    out: &std::path::Path,
+    make: impl FnOnce() -> Result<(latvox::io::threemf::BeamModel, R)>,
+) -> Result<R> {
+    if !out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("3mf"))
+    {
+        return Err(latvox::Error::invalid(format!(
+            "{}: beams are written to 3MF only: name the output .3mf",
+            out.display()
+        )));
+    }
+    latvox::io::atomic::check_writable(out)?;
+    let (model, report) = make()?;
+    latvox::io::atomic::write_atomic(out, |w| latvox::io::threemf::write_beams(&model, w))?;
+    Ok(report)
+}
+
 /// The density line of a part made to a density (or with one measured).
 pub(crate) fn print_density(p: &PartReport) {
     match p.target_density {

@@ -10,7 +10,7 @@ use super::{parse_density, parse_length0, parse_positive, write_json};
 use clap::Args;
 use latvox::strut::cell::BUILT_IN;
 use latvox::strut::{BeamsReport, Sizing, StrutJob, StrutReport, UnitCell};
-use latvox::{Error, Result};
+use latvox::Result;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -219,18 +219,7 @@ pub fn execute(a: &StrutArgs, progress: &latvox::progress::Progress) -> Result<M
         return Ok(Made::Mesh(Box::new(report)));
     }
     let out = &a.mesh.output;
-    let is_3mf = out
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("3mf"));
-    if !is_3mf {
-        return Err(Error::invalid(format!(
-            "{}: beams are written to 3MF only: name the output .3mf",
-            out.display()
-        )));
-    }
-    latvox::io::atomic::check_writable(out)?;
-    let (model, mut report) = job.beams(progress)?;
-    latvox::io::atomic::write_atomic(out, |w| latvox::io::threemf::write_beams(&model, w))?;
+    let mut report = super::lattice::write_beams(out, || job.beams(progress))?;
     report.output = Some(out.display().to_string());
     Ok(Made::Beams(Box::new(report)))
 }

@@ -4,10 +4,14 @@
 use super::command::{job, parsed, Command, PartKeys};
 use super::lattice::{human, named_field, print_density, print_part, triple, MeshArgs, PartArgs};
 use super::out::outln;
-use super::{parse_density, parse_finite3, parse_positive, parse_positive3, parse_unit};
+use super::{
+    parse_density, parse_finite3, parse_positive, parse_positive3, parse_unit, write_json,
+};
 use clap::{Args, ValueEnum};
 use latvox::field::Aabb;
-use latvox::voronoi::{seeds, Seeding, Sizing, Spacing, Structure, VoronoiJob, VoronoiReport};
+use latvox::voronoi::{
+    seeds, Seeding, Sizing, Spacing, Structure, VoronoiBeamsReport, VoronoiJob, VoronoiReport,
+};
 use latvox::Result;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -26,6 +30,9 @@ Examples:
   # Halfway between a random foam and the Kelvin foam (regularity 1: BCC seeds, Kelvin
   # cells); the same --seed gives the same file, byte for byte
   latvox voronoi --spacing 3 --regularity 0.5 --seed 7 --density 0.15 -o half.stl
+
+  # The same net as 3MF beams (each Voronoi edge a beam, the box a clipping mesh): kilobytes
+  latvox voronoi --spacing 3 --density 0.15 -r 12 --beams -o foam-beams.3mf
 
   # Your own seeds (x,y,z per line, mm), and the seeds a run used written out
   latvox voronoi --spacing 3 --density 0.15 --seeds-out seeds.csv -o a.stl
@@ -116,6 +123,10 @@ pub struct VoronoiArgs {
     /// Wall thickness of a sheet, mm, instead of a density.
     #[arg(long, value_name = "MM", value_parser = parse_positive, allow_hyphen_values = true)]
     pub thickness: Option<f64>,
+    /// Write the net as beams (3MF Beam Lattice extension: each Voronoi edge a beam of the
+    /// radius, the box a clipping mesh) instead of a mesh. The output must be .3mf.
+    #[arg(long)]
+    pub beams: bool,
     /// Box size in mm: S or SX,SY,SZ.
     #[arg(long, value_name = "MM[,MM,MM]", default_value = "20", value_parser = parse_positive3, allow_hyphen_values = true)]
     pub size: [f64; 3],
@@ -138,8 +149,12 @@ impl latvox::batch::Task for VoronoiArgs {
     }
 
     fn run(&self) -> Result<latvox::batch::TaskReport> {
-        let r = execute(self, &latvox::progress::Progress::hidden())?;
-        latvox::batch::TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
+        match execute(self, &latvox::progress::Progress::hidden())? {
+            Made::Mesh(r) => {
+                latvox::batch::TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
+            }
+            Made::Beams(r) => latvox::batch::TaskReport::new(&r, &r.verdict(), Vec::new()),
+        }
     }
 }
 
@@ -200,28 +215,83 @@ impl VoronoiArgs {
     }
 }
 
-pub fn run(a: &VoronoiArgs, quiet: bool) -> Result<i32> {
-    a.mesh.check_report()?;
-    let report = execute(a, &latvox::progress::Progress::new(quiet))?;
-    let code = a.mesh.finish(&report, &report.part)?;
-    print_summary(a, &report);
-    Ok(code)
+/// What a run made: a meshed part, or beams.
+pub enum Made {
+    /// The part as a mesh.
+    Mesh(Box<VoronoiReport>),
+    /// The net as 3MF beams.
+    Beams(Box<VoronoiBeamsReport>),
 }
 
-/// Runs the job and writes its mesh (and seeds) atomically; returns the report.
-pub fn execute(a: &VoronoiArgs, progress: &latvox::progress::Progress) -> Result<VoronoiReport> {
+pub fn run(a: &VoronoiArgs, quiet: bool) -> Result<i32> {
+    a.mesh.check_report()?;
+    match execute(a, &latvox::progress::Progress::new(quiet))? {
+        Made::Mesh(report) => {
+            let code = a.mesh.finish(&report, &report.part)?;
+            print_summary(a, &report);
+            Ok(code)
+        }
+        Made::Beams(report) => {
+            if let Some(r) = &a.mesh.report {
+                write_json(r, &report)?;
+            }
+            outln!(
+                "Voronoi net as beams · box {} mm · {} beams of radius {:.4} mm between {} vertices, clipped by the box",
+                triple(a.size),
+                report.beams,
+                report.radius,
+                report.vertices
+            );
+            if let (Some(t), Some(f), Some(res)) = (
+                report.target_density,
+                report.meshed_density,
+                report.resolution,
+            ) {
+                outln!(
+                    "density   target {t:.4}  meshed at this radius {f:.4}  ({res} voxels per spacing)"
+                );
+            }
+            outln!("time      {:.3} s", report.seconds);
+            if let Some(o) = &report.output {
+                outln!("wrote     {o}");
+            }
+            Ok(report.verdict().exit_code())
+        }
+    }
+}
+
+/// Writes the seeds a run used, when asked.
+fn write_seeds(a: &VoronoiArgs, seeds: &[latvox::field::Vec3]) -> Result<()> {
+    if let Some(s) = &a.seeds_out {
+        let csv = seeds::to_csv(seeds);
+        latvox::io::atomic::write_atomic(s, |w| w.write_all(csv.as_bytes()))?;
+    }
+    Ok(())
+}
+
+/// Runs the job and writes its mesh or beams (and seeds) atomically; returns the report.
+pub fn execute(a: &VoronoiArgs, progress: &latvox::progress::Progress) -> Result<Made> {
     let job = a.job()?;
     if let Some(s) = &a.seeds_out {
         latvox::io::atomic::check_writable(s)?;
     }
+    if a.beams {
+        if matches!(a.structure, StructureArg::Sheet) {
+            return Err(latvox::Error::invalid(
+                "a sheet's walls cannot be written as beams: drop --beams, or make a net",
+            ));
+        }
+        let out = &a.mesh.output;
+        let mut report = super::lattice::write_beams(out, || job.beams(progress))?;
+        report.output = Some(out.display().to_string());
+        write_seeds(a, &report.seeds)?;
+        return Ok(Made::Beams(Box::new(report)));
+    }
     let report = a
         .mesh
         .write(|sink| job.run_into(progress, sink), |r| &mut r.part)?;
-    if let Some(s) = &a.seeds_out {
-        let csv = seeds::to_csv(&report.seeds);
-        latvox::io::atomic::write_atomic(s, |w| w.write_all(csv.as_bytes()))?;
-    }
-    Ok(report)
+    write_seeds(a, &report.seeds)?;
+    Ok(Made::Mesh(Box::new(report)))
 }
 
 fn print_summary(a: &VoronoiArgs, r: &VoronoiReport) {

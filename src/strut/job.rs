@@ -147,20 +147,11 @@ impl BeamsReport {
     /// The beams' verdict: no surface to check (the beams are capsules by definition), so only
     /// whether the meshed part the radius was found on met its density.
     pub fn verdict(&self) -> Verdict {
-        Verdict {
-            closed: true,
-            manifold: true,
-            outward: true,
-            self_intersection_checked: false,
-            self_intersecting: false,
-            sound_facets: true,
-            one_piece: None,
-            density_met: self
-                .target_density
+        Verdict::of_beams(
+            self.target_density
                 .zip(self.meshed_density)
                 .map(|(t, f)| (f - t).abs() <= pipeline::PROMISE),
-            features_printable: None,
-        }
+        )
     }
 }
 

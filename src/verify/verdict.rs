@@ -34,6 +34,23 @@ pub struct Verdict {
 }
 
 impl Verdict {
+    /// The verdict of beams (3MF capsules, valid by definition: no surface to check), whose
+    /// radius was found on a meshed part that met its density or not (`None`: no density
+    /// asked).
+    pub fn of_beams(density_met: Option<bool>) -> Verdict {
+        Verdict {
+            closed: true,
+            manifold: true,
+            outward: true,
+            self_intersection_checked: false,
+            self_intersecting: false,
+            sound_facets: true,
+            one_piece: None,
+            density_met,
+            features_printable: None,
+        }
+    }
+
     /// A valid closed, outward solid: every property holds (self-intersections count only when
     /// they were looked for).
     pub fn is_valid_solid(&self) -> bool {

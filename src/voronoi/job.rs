@@ -10,6 +10,7 @@ use crate::field::density::DensityField;
 use crate::field::{Aabb, Vec3};
 use crate::geom::Mesh;
 use crate::io::sink::{MeshCollector, MeshSink};
+use crate::io::threemf::BeamModel;
 use crate::lattice::strut::MIN_STRUT_VOXELS;
 use crate::lattice::voronoi::{seeds, Foam, FoamFamily, FoamStats, Structure};
 use crate::mesh::pipeline::{self, Family, Found, Options, Route};
@@ -140,6 +141,50 @@ impl VoronoiReport {
     /// The part's verdict.
     pub fn verdict(&self) -> Verdict {
         self.part.verdict()
+    }
+}
+
+/// The JSON report of a Voronoi net written as beams.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct VoronoiBeamsReport {
+    /// The beams' radius, mm.
+    pub radius: f64,
+    /// The volume fraction asked for (`null` when the radius was given).
+    pub target_density: Option<f64>,
+    /// The volume fraction of the part meshed at this radius, which the radius was found on
+    /// (`null` when the radius was given).
+    pub meshed_density: Option<f64>,
+    /// Voxels per spacing of that meshing.
+    pub resolution: Option<u32>,
+    /// Beams written.
+    pub beams: u64,
+    /// Vertices the beams join.
+    pub vertices: u64,
+    /// What clips the beams: the box, as a clipping mesh.
+    pub clipped_by: &'static str,
+    /// The part's box, mm.
+    #[serde(rename = "box")]
+    pub bounds: Aabb,
+    /// The diagram: cells, their sizes, edge lengths.
+    pub foam: FoamStats,
+    /// Wall time, seconds.
+    pub seconds: f64,
+    /// The output file, when the command line wrote one.
+    pub output: Option<String>,
+    /// The seeds the diagram was made of, for `--seeds-out`.
+    #[serde(skip)]
+    pub seeds: Vec<Vec3>,
+}
+
+impl VoronoiBeamsReport {
+    /// The beams' verdict: capsules by definition, so only whether the meshed part the radius
+    /// was found on met its density.
+    pub fn verdict(&self) -> Verdict {
+        Verdict::of_beams(
+            self.target_density
+                .zip(self.meshed_density)
+                .map(|(t, f)| (f - t).abs() <= pipeline::PROMISE),
+        )
     }
 }
 
@@ -442,6 +487,61 @@ impl VoronoiJob {
             part,
             seeds: foam.seeds().to_vec(),
         })
+    }
+
+    /// A net as beams (the 3MF Beam Lattice extension's): every Voronoi edge that reaches into
+    /// the box, a capsule of the radius given or of the radius at which the meshed part has the
+    /// target density, the box a clipping mesh.
+    pub fn beams(&self, progress: &Progress) -> Result<(BeamModel, VoronoiBeamsReport)> {
+        let start = Instant::now();
+        if self.structure != Structure::Net {
+            return Err(Error::invalid(
+                "a sheet's walls cannot be written as beams: drop --beams, or make a net",
+            ));
+        }
+        let (foam, spacing) = self.foam(progress)?;
+        let family = FoamFamily {
+            foam: Arc::new(foam),
+        };
+        let foam = &family.foam;
+        let voxel0 = Self::voxel(spacing, self.resolution);
+        let (radius, measured, resolution, target) = match self.sizing {
+            Sizing::Level(r) => {
+                self.refuse_closed(foam, r, voxel0, self.resolution)?;
+                (r, None, None, None)
+            }
+            Sizing::Density(d) => {
+                if d > self.range(foam, voxel0).max_density {
+                    self.refuse_closed(foam, foam.closing, voxel0, self.resolution)?;
+                }
+                let l0 = family.model_level(d);
+                self.refuse_closed(foam, l0, voxel0, self.resolution)?;
+                let resolved = self.search(&family, l0, spacing, progress)?;
+                let best = &resolved.found.best;
+                (
+                    best.level,
+                    Some(best.fraction),
+                    Some(resolved.resolution),
+                    Some(d),
+                )
+            }
+        };
+        let model = foam.beam_model(radius);
+        let report = VoronoiBeamsReport {
+            radius,
+            target_density: target,
+            meshed_density: measured,
+            resolution,
+            beams: model.beams.len() as u64,
+            vertices: model.vertices.len() as u64,
+            clipped_by: "box",
+            bounds: self.bounds,
+            foam: foam.stats,
+            seconds: start.elapsed().as_secs_f64(),
+            output: None,
+            seeds: foam.seeds().to_vec(),
+        };
+        Ok((model, report))
     }
 
     /// Finds the resolution and level of the part: the level given, or the one at which the

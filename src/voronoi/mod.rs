@@ -5,4 +5,6 @@
 pub mod job;
 
 pub use crate::lattice::voronoi::{seeds, FoamStats, Spread, Structure};
-pub use job::{Seeding, Sizing, Spacing, VoronoiJob, VoronoiRange, VoronoiReport};
+pub use job::{
+    Seeding, Sizing, Spacing, VoronoiBeamsReport, VoronoiJob, VoronoiRange, VoronoiReport,
+};

@@ -297,6 +297,56 @@ fn full_regularity_is_the_kelvin_foam() {
     assert!((r["achieved_density"].as_f64().unwrap() - 0.12).abs() <= 0.002);
 }
 
+/// A net as 3MF beams: lib3mf reads as many beams as the report gives, each of the radius
+/// found on the meshed part, which met the density.
+#[test]
+fn a_net_is_written_as_3mf_beams() {
+    let dir = tempdir();
+    let d = dir.path();
+    ok(
+        &[
+            "voronoi",
+            "--spacing",
+            "3",
+            "--density",
+            "0.15",
+            "--size",
+            "12",
+            "-r",
+            "12",
+            "--beams",
+            "-q",
+            "-o",
+            "b.3mf",
+            "--report",
+            "b.json",
+        ],
+        d,
+    );
+    let r = json(&d.join("b.json"));
+    assert!((r["meshed_density"].as_f64().unwrap() - 0.15).abs() <= 0.002);
+    const SCRIPT: &str = r#"
+import sys, lib3mf
+w = lib3mf.get_wrapper()
+m = w.CreateModel()
+m.QueryReader("3mf").ReadFromFile(sys.argv[1])
+it = m.GetMeshObjects()
+beams, radii = 0, set()
+while it.MoveNext():
+    bl = it.GetCurrentMeshObject().BeamLattice()
+    for b in bl.GetBeams():
+        beams += 1
+        radii.update([round(b.Radii[0], 6), round(b.Radii[1], 6)])
+print(beams, len(radii), min(radii))
+"#;
+    let out = String::from_utf8(python(SCRIPT, &d.join("b.3mf"))).unwrap();
+    let v: Vec<f64> = out.split_whitespace().map(|x| x.parse().unwrap()).collect();
+    assert_eq!(v[0] as u64, r["beams"].as_u64().unwrap(), "{out}");
+    assert!(v[0] > 500.0, "{out}");
+    assert_eq!(v[1], 1.0, "{out}");
+    assert!((v[2] - r["radius"].as_f64().unwrap()).abs() < 1e-5, "{out}");
+}
+
 /// Bad settings are refused in one line, exit 2, nothing written.
 #[test]
 fn bad_settings_are_refused() {
@@ -316,6 +366,8 @@ fn bad_settings_are_refused() {
         (&["--seeds-in", "bad.csv"], "line 3"),
         (&["--seeds-in", "missing.csv"], "missing.csv"),
         (&["--spacing", "0.001"], "seeds"),
+        (&["--structure", "sheet", "--beams"], "sheet's walls"),
+        (&["--beams"], ".3mf"),
     ];
     for (extra, what) in cases {
         let mut args = vec![

@@ -78,7 +78,7 @@ pub fn beams(lattice: &StrutLattice) -> BeamModel {
 
 /// Distance from the segment `pq` to the box (0 when they meet): the distance to a box is
 /// convex along a line, so a golden-section search over the segment finds its minimum.
-fn segment_box_distance(p: Vec3, q: Vec3, b: &Aabb) -> f64 {
+pub fn segment_box_distance(p: Vec3, q: Vec3, b: &Aabb) -> f64 {
     let at = |t: f64| {
         let x = [0, 1, 2].map(|a| p[a] + t * (q[a] - p[a]));
         (0..3)

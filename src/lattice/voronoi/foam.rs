@@ -26,7 +26,9 @@ use crate::error::{Error, Result};
 use crate::field::beams::{segment_distance, Beam, BeamField, Cap};
 use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
+use crate::io::threemf::BeamModel;
 use crate::lattice::model::LevelModel;
+use crate::lattice::strut::beams::segment_box_distance;
 use crate::mesh::pipeline::{Family, Solid};
 use kiddo::{KdTree, SquaredEuclidean};
 use std::sync::Arc;
@@ -240,6 +242,37 @@ impl Foam {
                 caps: [Cap::Sphere; 2],
             })
             .collect()
+    }
+
+    /// The net as 3MF beams of `radius`: the Voronoi edges that reach into the box, their ends
+    /// shared, the box their clipping mesh.
+    pub fn beam_model(&self, radius: f64) -> BeamModel {
+        let d = &self.diagram;
+        let near = self.bounds.grown(radius);
+        let mut model = BeamModel {
+            radius,
+            min_length: 1e-4,
+            clip: Some(self.bounds),
+            ..BeamModel::default()
+        };
+        let mut index = vec![u32::MAX; d.vertices.len()];
+        for &[a, b] in &d.edges {
+            let (p, q) = (d.vertices[a as usize], d.vertices[b as usize]);
+            let reaches =
+                (0..3).all(|k| p[k].min(q[k]) <= near.max[k] && p[k].max(q[k]) >= near.min[k]);
+            if !reaches || segment_box_distance(p, q, &self.bounds) > radius {
+                continue;
+            }
+            let ends = [a, b].map(|v| {
+                if index[v as usize] == u32::MAX {
+                    index[v as usize] = model.vertices.len() as u32;
+                    model.vertices.push(d.vertices[v as usize]);
+                }
+                index[v as usize]
+            });
+            model.beams.push((ends, [radius; 2]));
+        }
+        model
     }
 
     /// The net's field at `radius`, exact within `reach` of the struts.
