@@ -392,6 +392,24 @@ impl VoronoiJob {
         Ok(Some((needed, why)))
     }
 
+    /// The level the search starts from: the one given, or the model's for the density;
+    /// refused (naming the range) where the pores close.
+    fn start_level(&self, family: &FoamFamily, voxel: f64) -> Result<f64> {
+        let foam = &family.foam;
+        let l0 = match self.sizing {
+            Sizing::Density(d) => {
+                if d > self.range(foam, voxel).max_density {
+                    // The model's level would close the pores: refuse naming the range.
+                    self.refuse_closed(foam, foam.closing, voxel, self.resolution)?;
+                }
+                family.model_level(d)
+            }
+            Sizing::Level(l) => l,
+        };
+        self.refuse_closed(foam, l0, voxel, self.resolution)?;
+        Ok(l0)
+    }
+
     /// The foam: seeds, diagram and density model.
     pub fn foam(&self, progress: &Progress) -> Result<(Foam, [f64; 2])> {
         self.validate()?;
@@ -423,18 +441,7 @@ impl VoronoiJob {
         };
         let foam = &family.foam;
         let voxel0 = Self::voxel(spacing, self.resolution);
-        let l0 = match self.sizing {
-            Sizing::Density(d) => {
-                let range = self.range(foam, voxel0);
-                if d > range.max_density {
-                    // The model's level would close the pores: refuse naming the range.
-                    self.refuse_closed(foam, foam.closing, voxel0, self.resolution)?;
-                }
-                family.model_level(d)
-            }
-            Sizing::Level(l) => l,
-        };
-        self.refuse_closed(foam, l0, voxel0, self.resolution)?;
+        let l0 = self.start_level(&family, voxel0)?;
         let resolved = self.search(&family, l0, spacing, progress)?;
         let Found {
             voxel,
@@ -507,15 +514,11 @@ impl VoronoiJob {
         let voxel0 = Self::voxel(spacing, self.resolution);
         let (radius, measured, resolution, target) = match self.sizing {
             Sizing::Level(r) => {
-                self.refuse_closed(foam, r, voxel0, self.resolution)?;
+                self.start_level(&family, voxel0)?;
                 (r, None, None, None)
             }
             Sizing::Density(d) => {
-                if d > self.range(foam, voxel0).max_density {
-                    self.refuse_closed(foam, foam.closing, voxel0, self.resolution)?;
-                }
-                let l0 = family.model_level(d);
-                self.refuse_closed(foam, l0, voxel0, self.resolution)?;
+                let l0 = self.start_level(&family, voxel0)?;
                 let resolved = self.search(&family, l0, spacing, progress)?;
                 let best = &resolved.found.best;
                 (
