@@ -4,11 +4,61 @@
 //! time, peak memory and triangles of each (one run each unless `-- --runs N`), and whether
 //! `latvox check` finds each output a closed, valid solid.
 //!
-//! Run: `cargo bench --bench voronoi`.
+//! Run: `cargo bench --bench voronoi`; `-- --scale N` for the memory of a periodic net of
+//! N×N×N foam cells (see [`scale`]).
 
+use latvox::field::Aabb;
+use latvox::mesh::pipeline::Options;
+use latvox::progress::Progress;
+use latvox::voronoi::{Seeding, Sizing, Spacing, Structure, VoronoiJob};
 use std::process::Command;
+use std::time::Instant;
 mod support;
-use support::{median, runs_arg, time_and_peak};
+use support::{median, peak_rss_mb, runs_arg, time_and_peak, DiscardedStl};
+
+/// `--scale N`: a periodic Voronoi net of N×N×N foam cells of 3 mm (a box of 3N mm), its
+/// repeating cell 12 mm (some 64 seeds), struts of radius 0.3 mm, 10 voxels per spacing (40 per repeating cell), copied
+/// from a template and streamed through STL records that are dropped; prints the time and the
+/// process's peak resident memory. Run once per size, each in its own process, to compare peaks.
+fn scale(n: u32) {
+    let t = Instant::now();
+    let edge = 3.0 * n as f64;
+    let job = VoronoiJob {
+        structure: Structure::Net,
+        seeding: Seeding::Poisson {
+            spacing: Spacing::Uniform(3.0),
+            seed: 1,
+            regularity: 0.0,
+        },
+        sizing: Sizing::Level(0.3),
+        bounds: Aabb {
+            min: [0.0; 3],
+            max: [edge; 3],
+        },
+        resolution: 10,
+        period: Some(12.0),
+        auto_resolution: false,
+        options: Options {
+            verify: latvox::verify::Verify::Full,
+            instancing: true,
+            ..Default::default()
+        },
+    };
+    let mut sink = DiscardedStl::default();
+    let r = job.run_into(&Progress::hidden(), &mut sink).unwrap();
+    println!(
+        "{n}x{n}x{n} foam cells ({edge} mm box, {} seeds a repeating cell of 12 mm, {:?} cells copied from a template of {:?}), radius 0.3 mm, 10 voxels per spacing: {} triangles ({:.1} GB of STL, dropped), density {:.4}, valid {}, {:.1} s, peak RSS {:.0} MB",
+        r.foam.cells,
+        r.part.instancing.as_ref().map(|i| i.part_cells),
+        r.part.instancing.as_ref().map(|i| i.template_cells),
+        sink.triangles,
+        (84 + 50 * sink.triangles) as f64 / 1e9,
+        r.part.achieved_density,
+        r.verdict().is_valid_solid(),
+        t.elapsed().as_secs_f64(),
+        peak_rss_mb()
+    );
+}
 
 fn triangles(path: &std::path::Path) -> u64 {
     let d = std::fs::read(path).unwrap();
@@ -28,6 +78,10 @@ fn valid(dir: &std::path::Path, file: &str) -> bool {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if let Some(i) = args.iter().position(|a| a == "--scale") {
+        scale(args[i + 1].parse().expect("--scale N"));
+        return;
+    }
     let runs = runs_arg(&args, 1);
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

@@ -303,6 +303,8 @@ def voronoi(
     regularity: Optional[Value] = None,
     seeds_in: Optional[Value] = None,
     seeds_out: Optional[Value] = None,
+    periodic: Optional[Value] = None,
+    cell_out: Optional[Value] = None,
     density: Optional[Value] = None,
     radius: Optional[Value] = None,
     thickness: Optional[Value] = None,
@@ -342,7 +344,12 @@ def voronoi(
         (default: 0)
     seeds_in: Your own seeds: a CSV file of x,y,z per line, mm (they should fill the box and a
         margin of a cell or two round it)
-    seeds_out: Write the seeds used (box and margin) to a CSV file
+    seeds_out: Write the seeds used (box and margin; a periodic foam's cell) to a CSV file
+    periodic: Make a foam that repeats with a cube of this edge, mm (at least two spacings), from
+        the box's lower corner: random inside the cell, seamless across cells, meshed once and
+        copied through a large box
+    cell_out: Write a periodic net's cell as a strut cell (JSON: nodes in unit-cell coordinates,
+        struts), for `strut --cell`, `fill --cell` and `homogenize --cell`
     density: Target volume fraction of solid, in (0, 1) (0.15 when no size is given)
     radius: Strut radius of a net, mm, instead of a density
     thickness: Wall thickness of a sheet, mm, instead of a density
@@ -394,6 +401,9 @@ def fill(
     skin: Optional[Value] = None,
     no_skin: bool = False,
     lattice: Optional[Value] = None,
+    spacing: Optional[Value] = None,
+    seed: Optional[Value] = None,
+    regularity: Optional[Value] = None,
     structure: Optional[Value] = None,
     cell_size: Optional[Value] = None,
     density: Optional[Value] = None,
@@ -431,8 +441,13 @@ def fill(
     skin: Thickness of the solid skin kept inside the part's surface, mm (default: 1)
     no_skin: No skin: the lattice cut by the part's surface (an open-cell part)
     lattice: The lattice: a TPMS (p, gyroid, d, iwp, s, frd, neovius, lidinoid, split-p), a strut
-        cell (sc, bcc, bccz, fcc, fccz, octet, kelvin, diamond, rhombic) or a strut cell file
-        (.json) (default: gyroid)
+        cell (sc, bcc, bccz, fcc, fccz, octet, kelvin, diamond, rhombic), a strut cell file (.json),
+        or voronoi (a random Voronoi net that repeats with the cell) (default: gyroid)
+    spacing: For a Voronoi lattice: the mean spacing of its seeds, mm (the cell holds about
+        cell³/spacing³ of them; a quarter of the cell when not given)
+    seed: For a Voronoi lattice: the random generator's seed
+    regularity: For a Voronoi lattice: move its seeds toward the body-centred cubic lattice, 0
+        random to 1 the Kelvin foam
     structure: For a TPMS lattice: net (F ≤ t) or sheet (|F| ≤ t) (default: net)
     cell_size: Cell size in mm: A or AX,AY,AZ (cells start at the lower corner of the part's box)
         (default: 5)

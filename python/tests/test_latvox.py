@@ -78,6 +78,22 @@ def test_voronoi_foam_at_its_density_and_the_same_seed_again():
     assert np.array_equal(a.vertices, b.vertices)
 
 
+def test_periodic_voronoi_foam_repeats_its_cell():
+    m = latvox.voronoi(spacing=3.0, periodic=6.0, density=0.2, size=(12.0, 12.0, 6.0),
+                       resolution=8, seed=2)
+    t = closed_solid(m)
+    assert m.report["period"] == 6.0
+    assert t.volume / (12 * 12 * 6) == pytest.approx(0.2, abs=0.002)
+    # The cell repeats: the section at x = 1 is the section at x = 7 moved by a cell (the
+    # field is sampled alike in every cell; the y and z of every crossing are the same).
+    a = t.section(plane_origin=[1.0, 0, 0], plane_normal=[1, 0, 0])
+    b = t.section(plane_origin=[7.0, 0, 0], plane_normal=[1, 0, 0])
+    assert a.length > 10.0
+    assert a.length == pytest.approx(b.length, rel=1e-6)
+    assert np.allclose(np.sort(a.vertices[:, 1:], axis=0), np.sort(b.vertices[:, 1:], axis=0),
+                       atol=1e-5)
+
+
 def test_fill_a_part_with_a_lattice():
     m = latvox.fill(str(EXAMPLES / "sphere.obj"), lattice="gyroid", density=0.2, skin=1.0,
                     cell_size=6.0, resolution=12)

@@ -6,7 +6,7 @@ use super::lattice::{human, print_grading, print_part, triple, GradeArgs, MeshAr
 use super::out::outln;
 use super::part::Part;
 use super::tpms::parse_structure;
-use super::{parse_density, parse_length0, parse_positive, parse_positive3};
+use super::{parse_density, parse_length0, parse_positive, parse_positive3, parse_unit};
 use clap::Args;
 use latvox::fill::{FillJob, FillReport, Infilling};
 use latvox::io::ReadOptions;
@@ -43,7 +43,9 @@ Examples:
       --density 0.3 -o implant-open.stl
 
 Lattices: TPMS p, gyroid (g), d, iwp, s, frd, neovius (n), lidinoid (l), split-p, as net or sheet (--structure);
-struts sc, bcc, bccz, fcc, fccz, octet, kelvin, diamond, rhombic; or a strut cell file (.json).
+struts sc, bcc, bccz, fcc, fccz, octet, kelvin, diamond, rhombic; a strut cell file (.json); or
+voronoi, a random Voronoi net (seeds --spacing apart, --seed, --regularity) that repeats with
+the cell, so that a large part is filled as fast as with any strut cell.
 The part is read from STL, OBJ, OFF, PLY or 3MF; one that is not closed is mended with latvox's
 repair first, or refused when repair cannot close it. --density is the lattice's volume
 fraction in the region it fills (the part less its skin and the kept solids): latvox meshes the
@@ -62,6 +64,9 @@ pub(crate) const COMMAND: Command = Command {
             "lattice",
             "structure",
             "cell-size",
+            "spacing",
+            "seed",
+            "regularity",
             "density",
             "density-grade",
             "density-field",
@@ -122,9 +127,21 @@ pub struct FillArgs {
     #[arg(long, conflicts_with = "skin")]
     pub no_skin: bool,
     /// The lattice: a TPMS (p, gyroid, d, iwp, s, frd, neovius, lidinoid, split-p), a strut cell (sc, bcc, bccz,
-    /// fcc, fccz, octet, kelvin, diamond, rhombic) or a strut cell file (.json).
+    /// fcc, fccz, octet, kelvin, diamond, rhombic), a strut cell file (.json), or voronoi (a
+    /// random Voronoi net that repeats with the cell).
     #[arg(long, value_name = "NAME|FILE.json", default_value = "gyroid")]
     pub lattice: String,
+    /// For a Voronoi lattice: the mean spacing of its seeds, mm (the cell holds about
+    /// cell³/spacing³ of them; a quarter of the cell when not given).
+    #[arg(long, value_name = "MM", value_parser = parse_positive, allow_hyphen_values = true)]
+    pub spacing: Option<f64>,
+    /// For a Voronoi lattice: the random generator's seed.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// For a Voronoi lattice: move its seeds toward the body-centred cubic lattice, 0 random to
+    /// 1 the Kelvin foam.
+    #[arg(long, value_name = "R", value_parser = parse_unit)]
+    pub regularity: Option<f64>,
     /// For a TPMS lattice: net (F ≤ t) or sheet (|F| ≤ t).
     #[arg(long, value_name = "net|sheet", default_value = "net", value_parser = parse_structure)]
     pub structure: Structure,
@@ -168,6 +185,21 @@ impl FillArgs {
     fn infilling(&self) -> Result<(Infilling, String)> {
         let name = self.lattice.trim();
         let lower = name.to_ascii_lowercase();
+        if lower == "voronoi" {
+            return self.voronoi();
+        }
+        if let Some(flag) = [
+            (self.spacing.is_some(), "--spacing"),
+            (self.seed.is_some(), "--seed"),
+            (self.regularity.is_some(), "--regularity"),
+        ]
+        .iter()
+        .find_map(|(given, flag)| given.then_some(flag))
+        {
+            return Err(Error::invalid(format!(
+                "{flag} sets a Voronoi lattice's seeds: use it with --lattice voronoi"
+            )));
+        }
         if let Some(surface) = Surface::parse(&lower) {
             let s = Infilling::Tpms {
                 surface,
@@ -188,6 +220,36 @@ impl FillArgs {
             "unknown lattice '{name}' (known: p, gyroid, d, iwp, s, frd, neovius, lidinoid, split-p, {}, or a cell file .json)",
             BUILT_IN.join(", ")
         )))
+    }
+
+    /// A random Voronoi net that repeats with the cell, as a strut cell.
+    fn voronoi(&self) -> Result<(Infilling, String)> {
+        if self.structure == Structure::Sheet {
+            return Err(Error::invalid(
+                "fill takes a Voronoi net (struts); for Voronoi walls make `latvox voronoi --structure sheet`",
+            ));
+        }
+        let shortest = self.cell_size.iter().cloned().fold(f64::INFINITY, f64::min);
+        let spacing = self.spacing.unwrap_or(0.25 * shortest);
+        let seed = self.seed.unwrap_or(1);
+        let merge = shortest / self.mesh.resolution.max(1) as f64;
+        let (cell, stats) = latvox::lattice::voronoi::periodic::random_net_cell(
+            self.cell_size,
+            spacing,
+            seed,
+            self.regularity.unwrap_or(0.0),
+            merge,
+        )?;
+        Ok((
+            Infilling::Strut {
+                cell: Arc::new(cell),
+            },
+            format!(
+                "Voronoi net ({} seeds a cell, spacing {} mm, seed {seed})",
+                stats.cells,
+                human(spacing, 4)
+            ),
+        ))
     }
 
     /// The job the options describe.

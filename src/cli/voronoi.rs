@@ -4,6 +4,7 @@
 use super::command::{job, parsed, Command, PartKeys};
 use super::lattice::{human, named_field, print_density, print_part, triple, MeshArgs, PartArgs};
 use super::out::outln;
+use super::part::Part;
 use super::{
     parse_density, parse_finite3, parse_positive, parse_positive3, parse_unit, write_json,
 };
@@ -34,6 +35,11 @@ Examples:
   # The same net as 3MF beams (each Voronoi edge a beam, the box a clipping mesh): kilobytes
   latvox voronoi --spacing 3 --density 0.15 -r 12 --beams -o foam-beams.3mf
 
+  # A foam that repeats every 12 mm (random inside each cell, no seam between cells): a part
+  # of any size is copied from a few meshed cells; the net's cell saved as a strut cell
+  latvox voronoi --spacing 3 --periodic 12 --density 0.15 --size 48 -r 10 -o big.stl --cell-out foam-cell.json
+  latvox strut --cell foam-cell.json --cell-size 12 --density 0.2 --size 24 -r 40 -o denser.stl
+
   # Your own seeds (x,y,z per line, mm), and the seeds a run used written out
   latvox voronoi --spacing 3 --density 0.15 --seeds-out seeds.csv -o a.stl
   latvox voronoi --seeds-in seeds.csv --density 0.2 -o b.stl
@@ -45,7 +51,9 @@ than a voxel merged. With --density, latvox finds the strut radius (net) or wall
 (sheet) at which the written mesh has that volume fraction; members under 2 voxels across
 raise the resolution (--resolution counts voxels per spacing, the smallest where it varies);
 sizes at which one pore in ten closes are refused, with the range the foam allows. A sheet's
-cells are closed: each is a void of its own.";
+cells are closed: each is a void of its own. With --periodic, the seeds fill one cell (from the
+box's lower corner) measured with their copies in the cells round it, so the foam tiles space;
+a periodic net is a strut lattice whose cell --cell-out writes (for strut, fill, homogenize).";
 
 /// `latvox voronoi`.
 pub(crate) const COMMAND: Command = Command {
@@ -57,6 +65,7 @@ pub(crate) const COMMAND: Command = Command {
             "seed",
             "regularity",
             "seeds-in",
+            "periodic",
             "density",
             "radius",
             "thickness",
@@ -66,6 +75,11 @@ pub(crate) const COMMAND: Command = Command {
         shared: super::part::MESHING,
     }),
     job: Some(job::<VoronoiArgs>),
+    trace: Some(|m, f| {
+        Ok(Part::Block(Box::new(
+            parsed::<VoronoiArgs>(m)?.job()?.model(f)?,
+        )))
+    }),
     choices: Some(|| serde_json::json!({ "structure": ["net", "sheet"] })),
     ..Command::new(
         "voronoi",
@@ -111,9 +125,18 @@ pub struct VoronoiArgs {
     /// of a cell or two round it).
     #[arg(long, value_name = "FILE.csv")]
     pub seeds_in: Option<PathBuf>,
-    /// Write the seeds used (box and margin) to a CSV file.
+    /// Write the seeds used (box and margin; a periodic foam's cell) to a CSV file.
     #[arg(long, value_name = "FILE.csv")]
     pub seeds_out: Option<PathBuf>,
+    /// Make a foam that repeats with a cube of this edge, mm (at least two spacings), from
+    /// the box's lower corner: random inside the cell, seamless across cells, meshed once and
+    /// copied through a large box.
+    #[arg(long, value_name = "MM", value_parser = parse_positive, allow_hyphen_values = true, conflicts_with = "spacing_field")]
+    pub periodic: Option<f64>,
+    /// Write a periodic net's cell as a strut cell (JSON: nodes in unit-cell coordinates,
+    /// struts), for `strut --cell`, `fill --cell` and `homogenize --cell`.
+    #[arg(long, value_name = "FILE.json", requires = "periodic")]
+    pub cell_out: Option<PathBuf>,
     /// Target volume fraction of solid, in (0, 1) (0.15 when no size is given).
     #[arg(long, short = 'd', value_parser = parse_density, allow_hyphen_values = true, conflicts_with_all = ["radius", "thickness"])]
     pub density: Option<f64>,
@@ -145,6 +168,7 @@ impl latvox::batch::Task for VoronoiArgs {
     fn outputs(&self) -> Vec<PathBuf> {
         let mut out = vec![self.mesh.output.clone()];
         out.extend(self.seeds_out.clone());
+        out.extend(self.cell_out.clone());
         out
     }
 
@@ -208,6 +232,7 @@ impl VoronoiArgs {
                 (None, d) => Sizing::Density(d.unwrap_or(0.15)),
             },
             bounds,
+            period: self.periodic,
             resolution: self.mesh.resolution,
             auto_resolution: !self.mesh.fixed_resolution,
             options: self.mesh.options(),
@@ -272,8 +297,13 @@ fn write_seeds(a: &VoronoiArgs, seeds: &[latvox::field::Vec3]) -> Result<()> {
 /// Runs the job and writes its mesh or beams (and seeds) atomically; returns the report.
 pub fn execute(a: &VoronoiArgs, progress: &latvox::progress::Progress) -> Result<Made> {
     let job = a.job()?;
-    if let Some(s) = &a.seeds_out {
+    for s in a.seeds_out.iter().chain(&a.cell_out) {
         latvox::io::atomic::check_writable(s)?;
+    }
+    if a.cell_out.is_some() && matches!(a.structure, StructureArg::Sheet) {
+        return Err(latvox::Error::invalid(
+            "--cell-out writes a periodic net's struts: a sheet's walls are not a strut cell",
+        ));
     }
     if a.beams {
         if matches!(a.structure, StructureArg::Sheet) {
@@ -291,6 +321,10 @@ pub fn execute(a: &VoronoiArgs, progress: &latvox::progress::Progress) -> Result
         .mesh
         .write(|sink| job.run_into(progress, sink), |r| &mut r.part)?;
     write_seeds(a, &report.seeds)?;
+    if let (Some(path), Some(cell)) = (&a.cell_out, &report.cell) {
+        let json = cell.to_json();
+        latvox::io::atomic::write_atomic(path, |w| w.write_all(json.as_bytes()))?;
+    }
     Ok(Made::Mesh(Box::new(report)))
 }
 
@@ -312,10 +346,12 @@ fn print_summary(a: &VoronoiArgs, r: &VoronoiReport) {
         human(r.voxel_size, 4)
     );
     let f = &r.foam;
+    let cells = match r.period {
+        Some(l) => format!("{} per repeating cell of {} mm", f.cells, human(l, 4)),
+        None => format!("{} in the box ({} seeds with the margin)", f.cells, f.seeds),
+    };
     outln!(
-        "cells     {} in the box ({} seeds with the margin) · cell diameter {:.3} mm (5–95 %: {:.3}–{:.3})",
-        f.cells,
-        f.seeds,
+        "cells     {cells} · cell diameter {:.3} mm (5–95 %: {:.3}–{:.3})",
         f.cell_diameter.mean,
         f.cell_diameter.p5,
         f.cell_diameter.p95
@@ -332,5 +368,13 @@ fn print_summary(a: &VoronoiArgs, r: &VoronoiReport) {
     print_part(p);
     if let Some(s) = &a.seeds_out {
         outln!("seeds     {} written to {}", r.seeds.len(), s.display());
+    }
+    if let (Some(c), Some(cell)) = (&a.cell_out, &r.cell) {
+        outln!(
+            "cell      {} struts between {} nodes written to {}",
+            cell.struts.len(),
+            cell.nodes.len(),
+            c.display()
+        );
     }
 }

@@ -446,6 +446,7 @@ impl FillJob {
             thin: self.thin(members),
             density: Some(self.density),
             auto: self.auto_resolution,
+            per: "cell",
         };
         resolution::search(&request, &mut |r| {
             let voxel = self.min_cell() / r as f64;

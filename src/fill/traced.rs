@@ -72,15 +72,7 @@ impl FillJob {
             crate::render::Fidelity::Look => self.unit_cell_level(),
             crate::render::Fidelity::Volume => {
                 let bounded = FillJob {
-                    options: crate::mesh::pipeline::Options {
-                        memory: Some(
-                            self.options
-                                .memory
-                                .unwrap_or(crate::mesh::pipeline::DEFAULT_MEMORY)
-                                .min(crate::render::MODEL_MEMORY),
-                        ),
-                        ..self.options
-                    },
+                    options: crate::render::model_options(&self.options),
                     ..self.clone()
                 };
                 bounded.with_lattice(&part, &keep, &Progress::hidden(), Settle)?

@@ -36,6 +36,8 @@ pub struct Request {
     pub density: Option<f64>,
     /// Raise the resolution (`true`), or refuse naming the smallest that works.
     pub auto: bool,
+    /// What the resolution counts voxels per, for messages: "cell", "spacing".
+    pub per: &'static str,
 }
 
 /// The resolution found and what was found there.
@@ -126,10 +128,11 @@ pub fn search<T>(
             requested: request.requested,
             needed: None,
             message: format!(
-                "no level gives {} a density of {} within {PROMISE} at {} to {limit} voxels per cell (closest {closest:.4}); the box may cut the lattice into pieces",
+                "no level gives {} a density of {} within {PROMISE} at {} to {limit} voxels per {} (closest {closest:.4}); the box may cut the lattice into pieces",
                 request.part,
                 request.density.unwrap_or(f64::NAN),
                 request.requested,
+                request.per,
             ),
         });
     };
@@ -139,13 +142,13 @@ pub fn search<T>(
         passed_over.push(if (miss.closest - target).abs() <= PROMISE {
             // The density was met, but the mesh had holes.
             format!(
-                "at {} voxels per cell the part comes out with holes: the voxels are too coarse for the lattice's members",
-                miss.resolution
+                "at {} voxels per {} the part comes out with holes: the voxels are too coarse for the lattice's members",
+                miss.resolution, request.per
             )
         } else {
             format!(
-                "at {} voxels per cell no level gives density {target} (closest {:.4}): the voxels are too coarse for the lattice's members",
-                miss.resolution, miss.closest
+                "at {} voxels per {} no level gives density {target} (closest {:.4}): the voxels are too coarse for the lattice's members",
+                miss.resolution, request.per, miss.closest
             )
         });
     }
@@ -161,8 +164,8 @@ pub fn search<T>(
             })
         }
         Some(why) => Some(format!(
-            "resolution raised from {} to {resolution} voxels per cell: {why}",
-            request.requested
+            "resolution raised from {} to {resolution} voxels per {}: {why}",
+            request.requested, request.per
         )),
         None => None,
     };

@@ -13,8 +13,9 @@ pub mod view;
 use crate::error::{Error, Result};
 use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
+use crate::lattice::strut::StrutFamily;
 use crate::mesh::pieces::Loose;
-use crate::mesh::pipeline::Solid;
+use crate::mesh::pipeline::{self, Family, Found, Options, Solid};
 use camera::{dot, normalized, Camera};
 use rayon::prelude::*;
 use std::path::Path;
@@ -37,6 +38,20 @@ pub enum Fidelity {
 /// level found does not depend on the tiles.
 pub const MODEL_MEMORY: u64 = 512 << 20;
 
+/// `options` with the memory budget capped at [`MODEL_MEMORY`], for the search a model's level
+/// is found by (in tiles beyond it).
+pub fn model_options(options: &Options) -> Options {
+    Options {
+        memory: Some(
+            options
+                .memory
+                .unwrap_or(pipeline::DEFAULT_MEMORY)
+                .min(MODEL_MEMORY),
+        ),
+        ..*options
+    }
+}
+
 /// A part as an implicit solid, at the level (a TPMS's `t`, a strut radius) its mesh is written
 /// at — found by the same search, on the same route and voxels — with the fragments its mesh
 /// drops: what rendering and slicing trace instead of a mesh. Its field is unclipped; the box
@@ -57,6 +72,36 @@ pub struct Model {
 }
 
 impl Model {
+    /// A strut lattice's model, its radius found by `found` (the part's search on its mesh):
+    /// the radius `given`, or the one the mesh is made to at, for slices
+    /// ([`Fidelity::Exact`]) moved so that the solid encloses the mesh's volume; with the
+    /// fragments the mesh drops.
+    pub fn of_struts(
+        family: &StrutFamily,
+        found: &Found,
+        given: Option<f64>,
+        target: Option<f64>,
+        fidelity: Fidelity,
+    ) -> Result<Model> {
+        let c = family.part.size;
+        let cell = c[0].min(c[1]).min(c[2]);
+        let step = pipeline::implicit_step(found.voxel, cell);
+        let radius = match given {
+            // A radius given is the part's radius, whatever its mesh encloses.
+            Some(r) => r,
+            None if fidelity == Fidelity::Look => found.best.level,
+            None => pipeline::implicit_level(family, &found.best, &found.tried, found.voxel, step),
+        };
+        Ok(Model {
+            level: radius,
+            lattice: Periodic::Struts(family.at(radius)),
+            voxel: found.voxel,
+            cell,
+            target,
+            loose: pipeline::loose(family, &found.best, found.voxel)?,
+        })
+    }
+
     /// The distance up to which a strut field is exact (its value is capped there): 0.15 of a
     /// cell, so that the augmented cell holds few struts and a step in empty space still
     /// crosses a good part of a cell (the fastest of 0.1–0.4 on BCC and filled parts).

@@ -191,37 +191,15 @@ impl StrutJob {
         }
         let (family, _) = self.family();
         let bounded = StrutJob {
-            options: Options {
-                memory: Some(
-                    self.options
-                        .memory
-                        .unwrap_or(pipeline::DEFAULT_MEMORY)
-                        .min(crate::render::MODEL_MEMORY),
-                ),
-                ..self.options
-            },
+            options: crate::render::model_options(&self.options),
             ..self.clone()
         };
         let resolved = bounded.search(&family, &Progress::hidden())?;
-        let found = &resolved.found;
-        let c = self.domain.cell;
-        let step = pipeline::implicit_step(found.voxel, c[0].min(c[1]).min(c[2]));
-        let radius = match self.sizing {
-            // A radius given is the part's radius, whatever its mesh encloses.
-            Sizing::Radius(r) => r,
-            Sizing::Density(_) if fidelity == crate::render::Fidelity::Look => found.best.level,
-            Sizing::Density(_) => {
-                pipeline::implicit_level(&family, &found.best, &found.tried, found.voxel, step)
-            }
+        let given = match self.sizing {
+            Sizing::Radius(r) => Some(r),
+            Sizing::Density(_) => None,
         };
-        Ok(crate::render::Model {
-            level: radius,
-            lattice: crate::render::Periodic::Struts(family.at(radius)),
-            voxel: found.voxel,
-            cell: c[0].min(c[1]).min(c[2]),
-            target: self.target(),
-            loose: pipeline::loose(&family, &found.best, found.voxel)?,
-        })
+        crate::render::Model::of_struts(&family, &resolved.found, given, self.target(), fidelity)
     }
 
     /// The voxel edge at `resolution` voxels per cell, mm.
@@ -286,6 +264,7 @@ impl StrutJob {
             thin,
             density: target,
             auto: self.auto_resolution,
+            per: "cell",
         };
         let opts = &self.options;
         resolution::search(&request, &mut |r| {

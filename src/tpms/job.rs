@@ -360,6 +360,7 @@ impl TpmsJob {
             thin: self.thin_walls(t0),
             density: Some(self.density),
             auto: self.auto_resolution,
+            per: "cell",
         }
     }
 

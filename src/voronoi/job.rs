@@ -11,8 +11,10 @@ use crate::field::{Aabb, Vec3};
 use crate::geom::Mesh;
 use crate::io::sink::{MeshCollector, MeshSink};
 use crate::io::threemf::BeamModel;
-use crate::lattice::strut::MIN_STRUT_VOXELS;
-use crate::lattice::voronoi::{seeds, Foam, FoamFamily, FoamStats, Structure};
+use crate::lattice::strut::beams::beams as strut_beams;
+use crate::lattice::strut::{StrutFamily, StrutLattice, UnitCell, MIN_STRUT_VOXELS};
+use crate::lattice::voronoi::{periodic, seeds, Foam, FoamFamily, FoamStats, Structure};
+use crate::mesh::instance;
 use crate::mesh::pipeline::{self, Family, Found, Options, Route};
 use crate::mesh::report::{LevelSearch, PartReport};
 use crate::mesh::resolution::{self, max_resolution, Resolved};
@@ -78,6 +80,9 @@ pub struct VoronoiJob {
     pub bounds: Aabb,
     /// Voxels per spacing (the smallest, where it varies).
     pub resolution: u32,
+    /// The edge of a cell that the foam repeats with, mm, starting at the box's lower corner
+    /// (a periodic foam); `None` for a foam random through the whole box.
+    pub period: Option<f64>,
     /// Raise the resolution when members would be too thin for the voxels.
     pub auto_resolution: bool,
     /// The pipeline's options.
@@ -127,7 +132,10 @@ pub struct VoronoiReport {
     pub resolution: u32,
     /// Voxel edge, mm.
     pub voxel_size: f64,
-    /// The diagram: cells, their sizes, edge lengths.
+    /// The edge of the cell the foam repeats with, mm (`null`: random through the box).
+    pub period: Option<f64>,
+    /// The diagram: cells, their sizes, edge lengths (of one repeating cell, for a periodic
+    /// foam).
     pub foam: FoamStats,
     /// The part as written.
     #[serde(flatten)]
@@ -135,6 +143,9 @@ pub struct VoronoiReport {
     /// The seeds the diagram was made of (box and margin), for `--seeds-out`.
     #[serde(skip)]
     pub seeds: Vec<Vec3>,
+    /// A periodic net's cell, as a strut cell.
+    #[serde(skip)]
+    pub cell: Option<Arc<UnitCell>>,
 }
 
 impl VoronoiReport {
@@ -216,6 +227,22 @@ impl VoronoiJob {
         if !s.iter().all(|x| *x > 0.0 && x.is_finite()) {
             return Err(Error::invalid("the box must have a positive size"));
         }
+        if let Some(l) = self.period {
+            match &self.seeding {
+                Seeding::Poisson {
+                    spacing: Spacing::Uniform(sp),
+                    ..
+                } => periodic::check_cell([l; 3], *sp)?,
+                Seeding::Poisson { .. } => {
+                    return Err(Error::invalid(
+                        "a periodic foam has one spacing: drop --spacing-field, or --periodic",
+                    ))
+                }
+                Seeding::Given(points) => {
+                    periodic::check_cell([l; 3], (l.powi(3) / points.len() as f64).cbrt())?
+                }
+            }
+        }
         resolution::check_resolution(self.resolution)
     }
 
@@ -245,6 +272,10 @@ impl VoronoiJob {
                 }
                 Ok([lo, hi])
             }
+            Seeding::Given(points) if self.period.is_some() => {
+                let s = (self.cell().volume() / points.len() as f64).cbrt();
+                Ok([s, s])
+            }
             Seeding::Given(points) => {
                 let inside = points.iter().filter(|p| self.bounds.contains(**p)).count();
                 if inside == 0 {
@@ -261,6 +292,18 @@ impl VoronoiJob {
     /// The seeds: the box and a margin of two spacings round it, so that the cells reaching
     /// into the box are whole.
     fn seeds(&self, spacing: [f64; 2]) -> Result<Vec<Vec3>> {
+        if self.period.is_some() {
+            let cell = self.cell();
+            return Ok(match &self.seeding {
+                Seeding::Given(points) => points.iter().map(|&p| seeds::wrap(p, &cell)).collect(),
+                Seeding::Poisson {
+                    seed, regularity, ..
+                } => {
+                    let points = seeds::poisson_periodic(&cell, spacing[0], *seed);
+                    seeds::regularise(&points, &cell, spacing[0], *regularity, *seed, true)
+                }
+            });
+        }
         match &self.seeding {
             Seeding::Given(points) => Ok(points.clone()),
             Seeding::Poisson {
@@ -276,7 +319,7 @@ impl VoronoiJob {
                 let points = seeds::poisson(&region, &|p| field.at(clamp(p)), *seed);
                 Ok(match field {
                     Spacing::Uniform(s) if *regularity > 0.0 => {
-                        seeds::regularise(&points, &region, *s, *regularity, *seed)
+                        seeds::regularise(&points, &region, *s, *regularity, *seed, false)
                     }
                     _ => points,
                 })
@@ -284,9 +327,32 @@ impl VoronoiJob {
         }
     }
 
-    /// The voxel edge at `resolution` voxels per spacing.
-    fn voxel(spacing: [f64; 2], resolution: u32) -> f64 {
-        spacing[0] / resolution as f64
+    /// The repeating cell of a periodic foam: from the box's lower corner, `period` wide (the
+    /// box itself when the foam is not periodic).
+    fn cell(&self) -> Aabb {
+        match self.period {
+            Some(l) => Aabb {
+                min: self.bounds.min,
+                max: self.bounds.min.map(|x| x + l),
+            },
+            None => self.bounds,
+        }
+    }
+
+    /// The voxel edge at `resolution` voxels per spacing: for a periodic foam, rounded down so
+    /// that a cell spans whole OpenVDB leaves (the part is then copied from a template).
+    fn voxel(&self, spacing: [f64; 2], resolution: u32) -> f64 {
+        match self.period {
+            Some(l) => l / self.cell_voxels(spacing, resolution) as f64,
+            None => spacing[0] / resolution as f64,
+        }
+    }
+
+    /// Voxels across a periodic cell at `resolution` voxels per spacing: whole leaves.
+    fn cell_voxels(&self, spacing: [f64; 2], resolution: u32) -> u32 {
+        let leaf = instance::BLOCK as f64;
+        let l = self.period.unwrap_or(spacing[0]);
+        ((resolution as f64 * l / spacing[0] / leaf).ceil() * leaf) as u32
     }
 
     /// The thinnest member (a radius or a thickness), [`MIN_STRUT_VOXELS`] across.
@@ -302,6 +368,17 @@ impl VoronoiJob {
         match self.structure {
             Structure::Net => 2.0 * level / voxel,
             Structure::Sheet => level / voxel,
+        }
+    }
+
+    /// Where the seeds came from (`poisson` or `file`), the generator's seed and the regularity,
+    /// for the report.
+    fn seeding_report(&self) -> (&'static str, Option<u64>, f64) {
+        match self.seeding {
+            Seeding::Poisson {
+                seed, regularity, ..
+            } => ("poisson", Some(seed), regularity),
+            Seeding::Given(_) => ("file", None, 0.0),
         }
     }
 
@@ -322,22 +399,28 @@ impl VoronoiJob {
         )
     }
 
-    fn range(&self, foam: &Foam, voxel: f64) -> VoronoiRange {
+    fn range(&self, family: &impl Members, voxel: f64) -> VoronoiRange {
         let min_level = self.min_level(voxel);
         VoronoiRange {
             min_level,
-            max_level: foam.closing,
-            min_density: foam.model.fraction(min_level),
-            max_density: foam.model.fraction(foam.closing),
+            max_level: family.closing(),
+            min_density: family.model_fraction(min_level),
+            max_density: family.model_fraction(family.closing()),
         }
     }
 
     /// Refuses a level or density at which the pores close (or, with none open, any).
-    fn refuse_closed(&self, foam: &Foam, level: f64, voxel: f64, resolution: u32) -> Result<()> {
-        if level < foam.closing {
+    fn refuse_closed(
+        &self,
+        family: &impl Members,
+        level: f64,
+        voxel: f64,
+        resolution: u32,
+    ) -> Result<()> {
+        if level < family.closing() {
             return Ok(());
         }
-        let range = self.range(foam, voxel);
+        let range = self.range(family, voxel);
         let name = self.structure.level_name();
         let (setting, value, min, max) = match self.sizing {
             Sizing::Density(d) => ("density", d, range.min_density, range.max_density),
@@ -370,7 +453,7 @@ impl VoronoiJob {
     /// [`MIN_STRUT_VOXELS`], and why; refused when even the finest searched would not do.
     fn thin(&self, level: f64, spacing: [f64; 2]) -> Result<Option<(u32, String)>> {
         let req = self.resolution;
-        let across = self.across(level, Self::voxel(spacing, req));
+        let across = self.across(level, self.voxel(spacing, req));
         if across >= MIN_STRUT_VOXELS {
             return Ok(None);
         }
@@ -385,7 +468,7 @@ impl VoronoiJob {
                     "{} at {}: {why}, and would need {needed} voxels per spacing; give a larger {name} or density (at {req} voxels per spacing: {name} ≥ {:.4} mm), or --resolution {needed}",
                     self.name(),
                     self.setting(),
-                    self.min_level(Self::voxel(spacing, req)),
+                    self.min_level(self.voxel(spacing, req)),
                 ),
             });
         }
@@ -394,19 +477,18 @@ impl VoronoiJob {
 
     /// The level the search starts from: the one given, or the model's for the density;
     /// refused (naming the range) where the pores close.
-    fn start_level(&self, family: &FoamFamily, voxel: f64) -> Result<f64> {
-        let foam = &family.foam;
+    fn start_level(&self, family: &impl Members, voxel: f64) -> Result<f64> {
         let l0 = match self.sizing {
             Sizing::Density(d) => {
-                if d > self.range(foam, voxel).max_density {
+                if d > self.range(family, voxel).max_density {
                     // The model's level would close the pores: refuse naming the range.
-                    self.refuse_closed(foam, foam.closing, voxel, self.resolution)?;
+                    self.refuse_closed(family, family.closing(), voxel, self.resolution)?;
                 }
                 family.model_level(d)
             }
             Sizing::Level(l) => l,
         };
-        self.refuse_closed(foam, l0, voxel, self.resolution)?;
+        self.refuse_closed(family, l0, voxel, self.resolution)?;
         Ok(l0)
     }
 
@@ -419,8 +501,15 @@ impl VoronoiJob {
             self.seeds(spacing)?
         };
         let _p = progress.stage("computing the Voronoi diagram");
-        let voxel = Self::voxel(spacing, self.resolution);
-        let foam = Foam::new(self.structure, self.bounds, seeds, voxel, spacing[1])?;
+        let voxel = self.voxel(spacing, self.resolution);
+        let foam = match self.period {
+            Some(l) => {
+                let cell = self.cell();
+                let copies = periodic::with_copies(&seeds, &cell);
+                Foam::new(self.structure, cell, copies, voxel, spacing[1])?.repeating([l; 3])
+            }
+            None => Foam::new(self.structure, self.bounds, seeds, voxel, spacing[1])?,
+        };
         Ok((foam, spacing))
     }
 
@@ -435,14 +524,50 @@ impl VoronoiJob {
     pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<VoronoiReport> {
         let start = Instant::now();
         let (foam, spacing) = self.foam(progress)?;
-        let model_seconds = start.elapsed().as_secs_f64();
-        let family = FoamFamily {
-            foam: Arc::new(foam),
+        match self.net_cell(&foam)? {
+            Some(family) => self.make(&family, &foam, spacing, start, progress, sink),
+            None => {
+                let family = FoamFamily {
+                    foam: Arc::new(foam),
+                    bounds: self.bounds,
+                };
+                self.make(&family, &family.foam, spacing, start, progress, sink)
+            }
+        }
+    }
+
+    /// A periodic net as a strut lattice: its cell's edges as a unit cell, repeated from the
+    /// box's lower corner (so that drawing, slicing and beams take it as any strut lattice);
+    /// `None` for other foams.
+    pub fn net_cell(&self, foam: &Foam) -> Result<Option<StrutFamily>> {
+        let (Some(l), Structure::Net) = (self.period, self.structure) else {
+            return Ok(None);
         };
-        let foam = &family.foam;
-        let voxel0 = Self::voxel(spacing, self.resolution);
-        let l0 = self.start_level(&family, voxel0)?;
-        let resolved = self.search(&family, l0, spacing, progress)?;
+        Ok(Some(StrutFamily::new(StrutLattice {
+            cell: Arc::new(periodic::net_cell(foam)?),
+            size: [l; 3],
+            radius: 0.0,
+            blend: 0.0,
+            bounds: self.bounds,
+            phase: self.bounds.min,
+        })))
+    }
+
+    /// Finds the level of `family` (the foam's, or its net's as a strut lattice), meshes,
+    /// writes and reports.
+    fn make(
+        &self,
+        family: &impl Members,
+        foam: &Foam,
+        spacing: [f64; 2],
+        start: Instant,
+        progress: &Progress,
+        sink: &mut dyn MeshSink,
+    ) -> Result<VoronoiReport> {
+        let model_seconds = start.elapsed().as_secs_f64();
+        let voxel0 = self.voxel(spacing, self.resolution);
+        let l0 = self.start_level(family, voxel0)?;
+        let resolved = self.search(family, l0, spacing, progress)?;
         let Found {
             voxel,
             route,
@@ -456,7 +581,7 @@ impl VoronoiJob {
             Sizing::Density(d) => Some(d),
             Sizing::Level(_) => None,
         };
-        let written = pipeline::write(&family, best, voxel, route, &self.options, progress, sink)?;
+        let written = pipeline::write(family, best, voxel, route, &self.options, progress, sink)?;
         let part = PartReport::after_search(
             self.bounds,
             target,
@@ -467,32 +592,26 @@ impl VoronoiJob {
             resolved.raised,
             start,
         );
-        let (seed, regularity) = match self.seeding {
-            Seeding::Poisson {
-                seed, regularity, ..
-            } => (Some(seed), regularity),
-            Seeding::Given(_) => (None, 0.0),
-        };
+        let (seeding, seed, regularity) = self.seeding_report();
         Ok(VoronoiReport {
             structure: self.structure,
-            seeding: match self.seeding {
-                Seeding::Poisson { .. } => "poisson",
-                Seeding::Given(_) => "file",
-            },
+            seeding,
             seed,
             regularity,
             spacing,
             radius: (self.structure == Structure::Net).then_some(level),
             thickness: (self.structure == Structure::Sheet).then_some(level),
             member_voxels: self.across(level, voxel),
-            feasible_range: self.range(foam, voxel),
+            feasible_range: self.range(family, voxel),
             level_search,
             resolution_requested: self.resolution,
             resolution: resolved.resolution,
             voxel_size: voxel,
+            period: self.period,
             foam: foam.stats,
             part,
-            seeds: foam.seeds().to_vec(),
+            seeds: foam.own_seeds().to_vec(),
+            cell: family.cell(),
         })
     }
 
@@ -507,19 +626,35 @@ impl VoronoiJob {
             ));
         }
         let (foam, spacing) = self.foam(progress)?;
-        let family = FoamFamily {
-            foam: Arc::new(foam),
-        };
-        let foam = &family.foam;
-        let voxel0 = Self::voxel(spacing, self.resolution);
+        match self.net_cell(&foam)? {
+            Some(family) => self.beams_of(&family, &foam, spacing, start, progress),
+            None => {
+                let family = FoamFamily {
+                    foam: Arc::new(foam),
+                    bounds: self.bounds,
+                };
+                self.beams_of(&family, &family.foam, spacing, start, progress)
+            }
+        }
+    }
+
+    fn beams_of(
+        &self,
+        family: &impl Members,
+        foam: &Foam,
+        spacing: [f64; 2],
+        start: Instant,
+        progress: &Progress,
+    ) -> Result<(BeamModel, VoronoiBeamsReport)> {
+        let voxel0 = self.voxel(spacing, self.resolution);
         let (radius, measured, resolution, target) = match self.sizing {
             Sizing::Level(r) => {
-                self.start_level(&family, voxel0)?;
+                self.start_level(family, voxel0)?;
                 (r, None, None, None)
             }
             Sizing::Density(d) => {
-                let l0 = self.start_level(&family, voxel0)?;
-                let resolved = self.search(&family, l0, spacing, progress)?;
+                let l0 = self.start_level(family, voxel0)?;
+                let resolved = self.search(family, l0, spacing, progress)?;
                 let best = &resolved.found.best;
                 (
                     best.level,
@@ -529,7 +664,7 @@ impl VoronoiJob {
                 )
             }
         };
-        let model = foam.beam_model(radius);
+        let model = family.beam_model(radius);
         let report = VoronoiBeamsReport {
             radius,
             target_density: target,
@@ -542,16 +677,42 @@ impl VoronoiJob {
             foam: foam.stats,
             seconds: start.elapsed().as_secs_f64(),
             output: None,
-            seeds: foam.seeds().to_vec(),
+            seeds: foam.own_seeds().to_vec(),
         };
         Ok((model, report))
+    }
+
+    /// The part as an implicit solid, for drawing and slicing from its settings: a periodic
+    /// net, as its strut lattice (the radius given, or the one its mesh is made to the density
+    /// at, in tiles beyond [`crate::render::MODEL_MEMORY`]; for slices moved so that it encloses
+    /// the mesh's volume). Other foams are drawn from their mesh.
+    pub fn model(&self, fidelity: crate::render::Fidelity) -> Result<crate::render::Model> {
+        self.validate()?;
+        let (foam, spacing) = self.foam(&Progress::hidden())?;
+        let Some(family) = self.net_cell(&foam)? else {
+            return Err(Error::invalid(
+                "a Voronoi foam is drawn and sliced from its mesh unless it is a periodic net (--periodic): make it with -o part.stl, then render, view or slice part.stl",
+            ));
+        };
+        let bounded = VoronoiJob {
+            options: crate::render::model_options(&self.options),
+            ..self.clone()
+        };
+        let voxel0 = self.voxel(spacing, self.resolution);
+        let l0 = self.start_level(&family, voxel0)?;
+        let resolved = bounded.search(&family, l0, spacing, &Progress::hidden())?;
+        let (given, target) = match self.sizing {
+            Sizing::Level(r) => (Some(r), None),
+            Sizing::Density(d) => (None, Some(d)),
+        };
+        crate::render::Model::of_struts(&family, &resolved.found, given, target, fidelity)
     }
 
     /// Finds the resolution and level of the part: the level given, or the one at which the
     /// part meshes to the target density.
     fn search(
         &self,
-        family: &FoamFamily,
+        family: &impl Members,
         l0: f64,
         spacing: [f64; 2],
         progress: &Progress,
@@ -567,6 +728,7 @@ impl VoronoiJob {
             thin: self.thin(l0, spacing)?,
             density: target,
             auto: self.auto_resolution,
+            per: "spacing",
         };
         let opts = &self.options;
         resolution::search(&request, &mut |r| {
@@ -575,9 +737,46 @@ impl VoronoiJob {
             } else {
                 "searching for a resolution that reaches the density"
             });
-            let voxel = Self::voxel(spacing, r);
+            let voxel = self.voxel(spacing, r);
             let route = Route::choose(&family.at(l0), voxel, opts);
             pipeline::find(family, target, l0, voxel, route, opts)
         })
+    }
+}
+
+/// What the job needs of a foam's family besides the pipeline's: the size at which its pores
+/// close, its beams, and, for a periodic net, its strut cell.
+trait Members: Family {
+    /// The largest level at which the pores stay open.
+    fn closing(&self) -> f64;
+    /// The net at `radius` as 3MF beams, the box clipping them.
+    fn beam_model(&self, radius: f64) -> BeamModel;
+    /// The strut cell, when the family is a periodic net's.
+    fn cell(&self) -> Option<Arc<UnitCell>> {
+        None
+    }
+}
+
+impl Members for FoamFamily {
+    fn closing(&self) -> f64 {
+        self.foam.closing
+    }
+
+    fn beam_model(&self, radius: f64) -> BeamModel {
+        self.foam.beam_model(radius)
+    }
+}
+
+impl Members for StrutFamily {
+    fn closing(&self) -> f64 {
+        self.model.closing
+    }
+
+    fn beam_model(&self, radius: f64) -> BeamModel {
+        strut_beams(&self.at(radius))
+    }
+
+    fn cell(&self) -> Option<Arc<UnitCell>> {
+        Some(self.part.cell.clone())
     }
 }

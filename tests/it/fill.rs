@@ -395,6 +395,19 @@ fn bad_input_is_refused_in_one_line() {
         (&["box.stl", "--no-skin", "--drain", "2"], "--no-skin"),
         (&["box.stl", "--drain", "0"], "drain"),
         (&["box.stl", "--drain", "11"], "too wide"),
+        (&["box.stl", "--spacing", "2"], "--lattice voronoi"),
+        (
+            &["box.stl", "--lattice", "octet", "--seed", "3"],
+            "--lattice voronoi",
+        ),
+        (
+            &["box.stl", "--lattice", "voronoi", "--structure", "sheet"],
+            "Voronoi net",
+        ),
+        (
+            &["box.stl", "--lattice", "voronoi", "--spacing", "3"],
+            "under 2 spacings",
+        ),
     ];
     for (args, what) in cases {
         assert_refused(d, args, what);

@@ -1,4 +1,5 @@
-//! `latvox voronoi`: Voronoi foams, nets and sheets, at their density; checked against the
+//! `latvox voronoi`: Voronoi foams, nets and sheets, random through the box or periodic, at
+//! their density; checked against the
 //! written mesh (volume, pieces and bounds measured here, CGAL's verdict), against SciPy's
 //! Voronoi diagram of the same seeds, and against the spacing field's cell count.
 
@@ -19,6 +20,8 @@ fn case(rng: &mut Rng, n: u64, dir: &Path) -> Option<String> {
     let origin = [0; 3].map(|_| rng.uniform(-20.0, 20.0));
     let resolution = 10 + rng.below(6);
     let seed = rng.next() % 1000;
+    // One foam in three repeats with a cell of two to three and a half spacings.
+    let periodic = (rng.below(3) == 0).then(|| format!("{:.3}", spacing * rng.uniform(2.0, 3.5)));
     let f = |v: [f64; 3]| format!("{:.3},{:.3},{:.3}", v[0], v[1], v[2]);
     let (size_s, origin_s) = (f(size), f(origin));
     let (spacing_s, density_s, res_s, seed_s) = (
@@ -27,7 +30,7 @@ fn case(rng: &mut Rng, n: u64, dir: &Path) -> Option<String> {
         resolution.to_string(),
         seed.to_string(),
     );
-    let args = [
+    let mut args = vec![
         "voronoi",
         "--structure",
         structure,
@@ -51,6 +54,9 @@ fn case(rng: &mut Rng, n: u64, dir: &Path) -> Option<String> {
         "--report",
         "p.json",
     ];
+    if let Some(p) = &periodic {
+        args.extend(["--periodic", p]);
+    }
     let what = format!("case {n}: {}", args.join(" "));
     let out = run(&args, dir);
     let err = String::from_utf8_lossy(&out.stderr);
@@ -110,7 +116,7 @@ fn property(seed: u64, cases: u64) {
 
 #[test]
 fn random_foams_meet_their_density_closed_and_in_one_piece() {
-    property(0x0f0a_2026, 3);
+    property(0x0f0a_2026, 4);
 }
 
 #[test]
@@ -368,6 +374,24 @@ fn bad_settings_are_refused() {
         (&["--spacing", "0.001"], "seeds"),
         (&["--structure", "sheet", "--beams"], "sheet's walls"),
         (&["--beams"], ".3mf"),
+        (&["--periodic", "5"], "under 2 spacings"),
+        (&["--spacing", "0.5", "--periodic", "9"], "more than 4000"),
+        (
+            &["--periodic", "9", "--spacing-field", "3"],
+            "--spacing-field",
+        ),
+        (&["--cell-out", "c.json"], "--periodic"),
+        (
+            &[
+                "--structure",
+                "sheet",
+                "--periodic",
+                "9",
+                "--cell-out",
+                "c.json",
+            ],
+            "not a strut cell",
+        ),
     ];
     for (extra, what) in cases {
         let mut args = vec![
@@ -383,5 +407,120 @@ fn bad_settings_are_refused() {
         let before = files_in(d);
         let out = run(&args, d);
         assert_refusal(d, &before, &out, &args, what);
+    }
+}
+
+/// A periodic foam (`--periodic`): a part of 4×4×4 repeating cells is copied from a template
+/// of 3×3×3, and SciPy's Voronoi diagram of the cell's seeds repeated through the box puts
+/// its edges (net) and faces (sheet) inside the written solid, in every cell, and its seeds
+/// outside; the net's cell, written with `--cell-out`, makes the same part through
+/// `latvox strut --cell`.
+#[test]
+fn a_periodic_foam_is_copied_from_its_cell_and_is_scipys_foam_in_every_cell() {
+    let dir = tempdir();
+    let d = dir.path();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference/voronoi.py");
+    for (structure, flag, level, res) in [
+        ("net", "--radius", "0.45", "6"),
+        ("sheet", "--thickness", "0.85", "6"),
+    ] {
+        let (out, rep, seeds) = (
+            format!("{structure}.stl"),
+            format!("{structure}.json"),
+            format!("{structure}.csv"),
+        );
+        let mut args = vec![
+            "voronoi",
+            "--structure",
+            structure,
+            "--spacing",
+            "3",
+            "--periodic",
+            "6.5",
+            "--size",
+            "26",
+            "--origin",
+            "-3,1.5,2",
+            "--seed",
+            "11",
+            flag,
+            level,
+            "--resolution",
+            res,
+            "--verify",
+            "cgal",
+            "-q",
+            "--seeds-out",
+            &seeds,
+            "-o",
+            &out,
+            "--report",
+            &rep,
+        ];
+        if structure == "net" {
+            args.extend(["--cell-out", "cell.json"]);
+        }
+        ok(&args, d);
+        let r = json(&d.join(&rep));
+        assert_eq!(r["period"], 6.5, "{structure}");
+        assert_eq!(r["instancing"]["part_cells"], serde_json::json!([4, 4, 4]));
+        assert_eq!(
+            r["instancing"]["template_cells"],
+            serde_json::json!([3, 3, 3])
+        );
+        let checks = &r["checks"];
+        assert!(
+            checks["closed"] == true && checks["self_intersecting"] == false,
+            "{structure}: {checks}"
+        );
+        let tris = read_stl(&d.join(&out));
+        assert_eq!(pieces(&tris), 1, "{structure}");
+        let o = std::process::Command::new("python3")
+            .arg(&script)
+            .args([&seeds, &out, structure, level, "0.6"])
+            .args(["-3", "1.5", "2", "23", "27.5", "28", "6.5", "200"])
+            .current_dir(d)
+            .output()
+            .expect("python3 with numpy and scipy (scripts/install-deps.sh --tests)");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        eprintln!("{structure}: {s}");
+        assert!(
+            s["member_points"].as_u64().unwrap() >= 150,
+            "{structure}: {s}"
+        );
+        assert_eq!(s["members_inside"], s["member_points"], "{structure}: {s}");
+        assert!(s["seeds"].as_u64().unwrap() >= 60, "{structure}: {s}");
+        assert_eq!(s["seeds_outside"], s["seeds"], "{structure}: {s}");
+        if structure == "net" {
+            // The same lattice from its cell file: the same volume.
+            ok(
+                &[
+                    "strut",
+                    "--cell",
+                    "cell.json",
+                    "--cell-size",
+                    "6.5",
+                    "--size",
+                    "26",
+                    "--origin",
+                    "-3,1.5,2",
+                    "--radius",
+                    "0.45",
+                    // 6 voxels per spacing, in whole OpenVDB leaves per cell.
+                    "--resolution",
+                    "16",
+                    "-q",
+                    "-o",
+                    "strut.stl",
+                ],
+                d,
+            );
+            let (a, b) = (volume(&tris), volume(&read_stl(&d.join("strut.stl"))));
+            assert!(
+                (a - b).abs() < 1e-3 * a,
+                "voronoi {a} mm³, strut --cell {b} mm³"
+            );
+        }
     }
 }

@@ -3,8 +3,11 @@ points sampled on its edges (net) or faces (sheet) well inside the box, and the 
 classified against the written STL by its generalised winding number (Jacobson et al. 2013,
 the Van Oosterom–Strackee solid angle of every triangle), in NumPy.
 
-usage: voronoi.py SEEDS.csv PART.stl net|sheet LEVEL MARGIN X0 Y0 Z0 X1 Y1 Z1
-  LEVEL: the strut radius or wall thickness; MARGIN: how far inside the box points are taken.
+usage: voronoi.py SEEDS.csv PART.stl net|sheet LEVEL MARGIN X0 Y0 Z0 X1 Y1 Z1 [PERIOD [POINTS]]
+  LEVEL: the strut radius or wall thickness; MARGIN: how far inside the box points are taken;
+  PERIOD: the seeds are one cell of this edge from the box's lower corner, repeated through the
+  box and a cell round it (a periodic foam); POINTS: how many member points to test (400; half
+  as many seeds).
 Prints JSON: the member points and how many lie inside, the seeds and how many lie outside.
 """
 import json
@@ -38,6 +41,14 @@ def main():
     level, margin = float(level), float(margin)
     box = np.array([float(x) for x in sys.argv[6:12]]).reshape(2, 3)
     seeds = np.loadtxt(seeds_path, delimiter=",", skiprows=1)
+    if len(sys.argv) > 12:
+        period = float(sys.argv[12])
+        cells = [int(np.ceil((box[1][k] - box[0][k]) / period)) for k in range(3)]
+        shifts = [np.array([i, j, k]) * period
+                  for i in range(-1, cells[0] + 1)
+                  for j in range(-1, cells[1] + 1)
+                  for k in range(-1, cells[2] + 1)]
+        seeds = np.concatenate([seeds + s for s in shifts])
     vor = Voronoi(seeds)
     inner = (box[0] + margin, box[1] - margin)
 
@@ -60,9 +71,11 @@ def main():
             members.append(centre)
             members.extend(centre + 0.5 * (v - centre) for v in poly)
     members = [p for p in members if within(p)]
-    # One point per member is plenty: keep the test quick.
-    members = np.array(members[: 400])
+    # Some hundreds of points spread over the box are plenty: keep the test quick.
+    n = int(sys.argv[13]) if len(sys.argv) > 13 else 400
+    members = np.array(members[:: max(1, len(members) // n)][:n])
     far = np.array([s for s in seeds if within(s)])
+    far = far[:: max(1, len(far) // (n // 2))]
     tris = read_stl(stl)
     wm = winding(tris, members)
     wf = winding(tris, far)

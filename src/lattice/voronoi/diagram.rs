@@ -78,8 +78,8 @@ impl Voronoi {
         })
     }
 
-    /// The diagram with vertices closer than `within` joined (each cluster at its first
-    /// vertex), the edges that become points and the faces that become segments dropped.
+    /// The diagram with vertices closer than `within` joined (each cluster at the mean of
+    /// its vertices), the edges that become points and the faces that become segments dropped.
     pub fn merged(&self, within: f64) -> Voronoi {
         let n = self.vertices.len();
         let mut parent: Vec<u32> = (0..n as u32).collect();
@@ -99,17 +99,26 @@ impl Voronoi {
                 }
             }
         }
-        // Renumber the surviving vertices in order.
+        // Renumber the surviving vertices in order, each at the mean of the vertices merged
+        // into it (so that translated copies of a diagram merge into translated vertices).
         let mut new = vec![u32::MAX; n];
-        let mut vertices = Vec::new();
+        let mut sums: Vec<(Vec3, f64)> = Vec::new();
         for i in 0..n as u32 {
             let r = root(&mut parent, i);
             if new[r as usize] == u32::MAX {
-                new[r as usize] = vertices.len() as u32;
-                vertices.push(self.vertices[r as usize]);
+                new[r as usize] = sums.len() as u32;
+                sums.push(([0.0; 3], 0.0));
             }
             new[i as usize] = new[r as usize];
+            let (sum, count) = &mut sums[new[i as usize] as usize];
+            let v = self.vertices[i as usize];
+            *sum = [0, 1, 2].map(|k| sum[k] + v[k]);
+            *count += 1.0;
         }
+        let vertices: Vec<Vec3> = sums
+            .iter()
+            .map(|(sum, count)| sum.map(|x| x / count))
+            .collect();
         let mut edges: Vec<[u32; 2]> = self
             .edges
             .iter()

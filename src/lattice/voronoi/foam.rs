@@ -21,9 +21,10 @@
 //! size.
 
 use super::diagram::Voronoi;
-use super::seeds::Rng;
+use super::seeds::{wrap, Rng};
 use crate::error::{Error, Result};
 use crate::field::beams::{segment_distance, Beam, BeamField, Cap};
+use crate::field::periodic::{block_axis, samples_per_cell};
 use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
 use crate::io::threemf::BeamModel;
@@ -131,6 +132,9 @@ pub struct Foam {
     pub stats: FoamStats,
     /// How far beyond the box a member may matter, mm.
     reach: f64,
+    /// The cell the foam repeats with, from the box's lower corner (a periodic foam: its box is
+    /// that cell, and its seeds the cell's followed by their copies in the 26 cells round it).
+    pub period: Option<Vec3>,
 }
 
 impl std::fmt::Debug for Foam {
@@ -216,6 +220,7 @@ impl Foam {
             closing: 0.0,
             stats,
             reach,
+            period: None,
         };
         foam.model = foam.measure_model();
         foam.closing = foam.closing_level();
@@ -225,6 +230,24 @@ impl Foam {
     /// The seeds.
     pub fn seeds(&self) -> &[Vec3] {
         &self.diagram.seeds
+    }
+
+    /// The foam made on a cell that repeats with `size` (its seeds the cell's, then their
+    /// copies round it, as [`super::periodic::with_copies`] gives them).
+    pub fn repeating(self, size: Vec3) -> Foam {
+        Foam {
+            period: Some(size),
+            ..self
+        }
+    }
+
+    /// The seeds that make the foam: all of them, or a periodic foam's cell's own.
+    pub fn own_seeds(&self) -> &[Vec3] {
+        let s = &self.diagram.seeds;
+        match self.period {
+            Some(_) => &s[..s.len() / 27],
+            None => s,
+        }
     }
 
     /// The edges that reach into the box, as segments.
@@ -487,9 +510,54 @@ impl Field for SheetField<'_> {
     }
 }
 
-impl Solid for FoamSolid {
-    fn field(&self, spec: &GridSpec) -> Box<dyn Field + '_> {
-        let reach = spec.half_width * spec.voxel;
+/// A periodic foam's field: the cell's, at the point's place in the cell (by the sample's index
+/// modulo the cell where the cell holds a whole number of voxels, so that samples a cell apart
+/// are bit-identical).
+struct Repeated<'a> {
+    inner: Box<dyn Field + 'a>,
+    cell: Aabb,
+    samples: Option<([u32; 3], f64)>,
+}
+
+impl Field for Repeated<'_> {
+    fn value(&self, p: Vec3) -> f64 {
+        self.inner.value(wrap(p, &self.cell))
+    }
+
+    fn clearance(&self, p: Vec3) -> f64 {
+        self.value(p).abs()
+    }
+
+    fn values(&self, points: &[Vec3], out: &mut [f64]) {
+        let wrapped: Vec<Vec3> = points.iter().map(|&p| wrap(p, &self.cell)).collect();
+        self.inner.values(&wrapped, out);
+    }
+
+    fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
+        let size = self.cell.size();
+        let axis = |a: usize| {
+            block_axis(self.samples, self.cell.min[a], size[a], origin[a], h, a)
+                .map(|f| self.cell.min[a] + f * size[a])
+        };
+        let [x, y, z] = [axis(0), axis(1), axis(2)];
+        let mut points = Vec::with_capacity(512);
+        for &px in &x {
+            for &py in &y {
+                for &pz in &z {
+                    points.push(wrap([px, py, pz], &self.cell));
+                }
+            }
+        }
+        let mut values = [0.0; 512];
+        self.inner.values(&points, &mut values);
+        for (o, v) in out.iter_mut().zip(values) {
+            *o = v as f32;
+        }
+    }
+}
+
+impl FoamSolid {
+    fn unrepeated(&self, reach: f64) -> Box<dyn Field + '_> {
         match self.foam.structure {
             Structure::Net => Box::new(self.foam.net_field(self.level, reach)),
             Structure::Sheet => Box::new(SheetField {
@@ -497,6 +565,20 @@ impl Solid for FoamSolid {
                 half: 0.5 * self.level,
                 reach,
             }),
+        }
+    }
+}
+
+impl Solid for FoamSolid {
+    fn field(&self, spec: &GridSpec) -> Box<dyn Field + '_> {
+        let inner = self.unrepeated(spec.half_width * spec.voxel);
+        match self.foam.period {
+            Some(size) => Box::new(Repeated {
+                inner,
+                cell: self.foam.bounds,
+                samples: samples_per_cell(size, spec.voxel),
+            }),
+            None => inner,
         }
     }
 
@@ -512,15 +594,19 @@ impl Solid for FoamSolid {
     }
 
     fn period(&self) -> Option<Vec3> {
-        None
+        self.foam
+            .period
+            .filter(|_| self.bounds.min == self.foam.bounds.min)
     }
 }
 
-/// A foam at every level.
+/// A foam at every level, clipped by a box (the foam's own, or any box for a periodic foam).
 #[derive(Debug, Clone)]
 pub struct FoamFamily {
     /// The foam.
     pub foam: Arc<Foam>,
+    /// The part's box.
+    pub bounds: Aabb,
 }
 
 impl Family for FoamFamily {
@@ -530,7 +616,7 @@ impl Family for FoamFamily {
         FoamSolid {
             foam: self.foam.clone(),
             level,
-            bounds: self.foam.bounds,
+            bounds: self.bounds,
         }
     }
 

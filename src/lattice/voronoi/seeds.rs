@@ -87,6 +87,40 @@ pub fn check_count(volume: f64, s_min: f64) -> Result<()> {
 
 /// Poisson-disk points filling `region`, at the spacing `spacing(p)` (mm, positive).
 pub fn poisson(region: &Aabb, spacing: &dyn Fn(Vec3) -> f64, seed: u64) -> Vec<Vec3> {
+    sample(region, spacing, seed, false)
+}
+
+/// Poisson-disk points at a uniform `spacing` in `cell` that tile space when the cell is
+/// repeated: a point's distance to the others is measured to their nearest copies, and a
+/// candidate that leaves the cell comes back through the opposite face. Every point lies in
+/// the half-open cell `[min, max)`.
+pub fn poisson_periodic(cell: &Aabb, spacing: f64, seed: u64) -> Vec<Vec3> {
+    sample(cell, &|_| spacing, seed, true)
+}
+
+/// The 27 translates of `p` by whole cells of `size` (itself first).
+pub fn images(p: Vec3, size: Vec3) -> impl Iterator<Item = Vec3> {
+    (0..27).map(move |n| {
+        let shift = [n % 3, (n / 3) % 3, n / 9].map(|x| [0.0, -1.0, 1.0][x]);
+        [0, 1, 2].map(|k| p[k] + shift[k] * size[k])
+    })
+}
+
+/// `p` moved by whole cells of `region` into it (half open).
+pub fn wrap(p: Vec3, region: &Aabb) -> Vec3 {
+    let size = region.size();
+    [0, 1, 2].map(|k| {
+        let x = region.min[k] + (p[k] - region.min[k]).rem_euclid(size[k]);
+        // rem_euclid may round up to the size itself.
+        if x >= region.max[k] {
+            region.min[k]
+        } else {
+            x
+        }
+    })
+}
+
+fn sample(region: &Aabb, spacing: &dyn Fn(Vec3) -> f64, seed: u64, periodic: bool) -> Vec<Vec3> {
     let mut rng = Rng::new(seed);
     let size = region.size();
     let inside = |p: Vec3| (0..3).all(|k| p[k] >= region.min[k] && p[k] <= region.max[k]);
@@ -96,17 +130,30 @@ pub fn poisson(region: &Aabb, spacing: &dyn Fn(Vec3) -> f64, seed: u64) -> Vec<V
     let free = |tree: &KdTree<f64, 3>, q: Vec3, r: f64| {
         tree.size() == 0 || tree.nearest_one::<SquaredEuclidean>(&q).distance >= r * r
     };
+    let add =
+        |tree: &mut KdTree<f64, 3>, points: &mut Vec<Vec3>, active: &mut Vec<usize>, q: Vec3| {
+            if periodic {
+                for image in images(q, size) {
+                    tree.add(&image, points.len() as u64);
+                }
+            } else {
+                tree.add(&q, points.len() as u64);
+            }
+            active.push(points.len());
+            points.push(q);
+        };
     // Start points spread over the region (a thin region may otherwise be reached only round
     // corners): one try per spacing-sized block.
     let s0 = spacing(region.centre()).max(1e-9);
     let blocks = size.map(|x| ((x / s0).ceil() as usize).max(1));
     let starts = (blocks[0] * blocks[1] * blocks[2]).min(4096);
     for _ in 0..starts {
-        let q = [0, 1, 2].map(|k| region.min[k] + rng.unit() * size[k]);
+        let mut q = [0, 1, 2].map(|k| region.min[k] + rng.unit() * size[k]);
+        if periodic {
+            q = wrap(q, region);
+        }
         if free(&tree, q, RADIUS * spacing(q)) {
-            tree.add(&q, points.len() as u64);
-            active.push(points.len());
-            points.push(q);
+            add(&mut tree, &mut points, &mut active, q);
         }
     }
     while !active.is_empty() {
@@ -122,14 +169,14 @@ pub fn poisson(region: &Aabb, spacing: &dyn Fn(Vec3) -> f64, seed: u64) -> Vec<V
                 continue;
             }
             let t = r * (1.0 + 7.0 * rng.unit()).cbrt() / len;
-            let q = [0, 1, 2].map(|k| p[k] + d[k] * t);
-            if !inside(q) {
+            let mut q = [0, 1, 2].map(|k| p[k] + d[k] * t);
+            if periodic {
+                q = wrap(q, region);
+            } else if !inside(q) {
                 continue;
             }
             if free(&tree, q, RADIUS * spacing(q)) {
-                tree.add(&q, points.len() as u64);
-                active.push(points.len());
-                points.push(q);
+                add(&mut tree, &mut points, &mut active, q);
                 placed = true;
                 break;
             }
@@ -142,40 +189,70 @@ pub fn poisson(region: &Aabb, spacing: &dyn Fn(Vec3) -> f64, seed: u64) -> Vec<V
 }
 
 /// `points` moved `regularity` of the way toward the body-centred cubic sites of cells of
-/// `spacing` (see the module's notes); `region` is where the points were made.
+/// `spacing` (see the module's notes); `region` is where the points were made. When
+/// `periodic`, the region is a cell that tiles space: the sites' cube is adjusted to a whole
+/// number per cell, distances are to the nearest copies, and the points stay in the cell.
 pub fn regularise(
     points: &[Vec3],
     region: &Aabb,
     spacing: f64,
     regularity: f64,
     seed: u64,
+    periodic: bool,
 ) -> Vec<Vec3> {
     if regularity <= 0.0 {
         return points.to_vec();
     }
     // Two sites per cube of edge a: a³ = 2 s³.
-    let a = 2f64.cbrt() * spacing;
-    let lo = region.min.map(|x| (x / a).floor() as i64 - 1);
-    let hi = region.max.map(|x| (x / a).ceil() as i64 + 1);
+    let a0 = 2f64.cbrt() * spacing;
+    let size = region.size();
     let mut sites = Vec::new();
-    for i in lo[0]..=hi[0] {
-        for j in lo[1]..=hi[1] {
-            for k in lo[2]..=hi[2] {
-                let c = [i as f64 * a, j as f64 * a, k as f64 * a];
-                for p in [c, c.map(|x| x + 0.5 * a)] {
-                    if region.contains(p) {
-                        sites.push(p);
+    let a = if periodic {
+        let n = size.map(|x| (x / a0).round().max(1.0));
+        let a = [0, 1, 2].map(|k| size[k] / n[k]);
+        for i in 0..n[0] as i64 {
+            for j in 0..n[1] as i64 {
+                for k in 0..n[2] as i64 {
+                    let c = [i, j, k].map(|x| x as f64);
+                    sites.push([0, 1, 2].map(|q| region.min[q] + c[q] * a[q]));
+                    sites.push([0, 1, 2].map(|q| region.min[q] + (c[q] + 0.5) * a[q]));
+                }
+            }
+        }
+        a
+    } else {
+        let lo = region.min.map(|x| (x / a0).floor() as i64 - 1);
+        let hi = region.max.map(|x| (x / a0).ceil() as i64 + 1);
+        for i in lo[0]..=hi[0] {
+            for j in lo[1]..=hi[1] {
+                for k in lo[2]..=hi[2] {
+                    let c = [i as f64 * a0, j as f64 * a0, k as f64 * a0];
+                    for p in [c, c.map(|x| x + 0.5 * a0)] {
+                        if region.contains(p) {
+                            sites.push(p);
+                        }
                     }
                 }
             }
         }
-    }
+        [a0; 3]
+    };
+    // Each site with its copies in the neighbouring cells when periodic.
+    let copies: Vec<(u32, Vec3)> = sites
+        .iter()
+        .enumerate()
+        .flat_map(|(n, &s)| {
+            images(s, size)
+                .take(if periodic { 27 } else { 1 })
+                .map(move |p| (n as u32, p))
+        })
+        .collect();
     let mut tree: KdTree<f64, 3> = KdTree::new();
-    for (n, s) in sites.iter().enumerate() {
-        tree.add(s, n as u64);
+    for (n, (_, p)) in copies.iter().enumerate() {
+        tree.add(p, n as u64);
     }
     // Candidate pairs within a cell's reach, nearest first.
-    let reach = a;
+    let reach = a.iter().cloned().fold(0.0, f64::max);
     let mut pairs: Vec<(f64, u32, u32)> = Vec::new();
     for (n, p) in points.iter().enumerate() {
         for nb in tree.within_unsorted::<SquaredEuclidean>(p, reach * reach) {
@@ -183,20 +260,22 @@ pub fn regularise(
         }
     }
     pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
-    let mut site_of = vec![u32::MAX; points.len()];
+    let mut copy_of = vec![u32::MAX; points.len()];
     let mut taken = vec![false; sites.len()];
-    for &(_, p, s) in &pairs {
-        if site_of[p as usize] == u32::MAX && !taken[s as usize] {
-            site_of[p as usize] = s;
-            taken[s as usize] = true;
+    for &(_, p, c) in &pairs {
+        let s = copies[c as usize].0 as usize;
+        if copy_of[p as usize] == u32::MAX && !taken[s] {
+            copy_of[p as usize] = c;
+            taken[s] = true;
         }
     }
+    let settle = |p: Vec3| if periodic { wrap(p, region) } else { p };
     let mut rng = Rng::new(seed.wrapping_add(1));
     let mut out = Vec::with_capacity(sites.len());
-    for (p, &s) in points.iter().zip(&site_of) {
-        if s != u32::MAX {
-            let t = sites[s as usize];
-            out.push([0, 1, 2].map(|k| p[k] + regularity * (t[k] - p[k])));
+    for (p, &c) in points.iter().zip(&copy_of) {
+        if c != u32::MAX {
+            let t = copies[c as usize].1;
+            out.push(settle([0, 1, 2].map(|k| p[k] + regularity * (t[k] - p[k]))));
         }
     }
     // A site without a point: one at random in its cell (within the inscribed ball of the
@@ -204,9 +283,8 @@ pub fn regularise(
     for (s, t) in sites.iter().enumerate() {
         if !taken[s] {
             let d = rng.in_ball();
-            let r = 0.433 * a;
-            let p = [0, 1, 2].map(|k| t[k] + r * d[k]);
-            out.push([0, 1, 2].map(|k| p[k] + regularity * (t[k] - p[k])));
+            let p = [0, 1, 2].map(|k| t[k] + 0.433 * a[k] * d[k]);
+            out.push(settle([0, 1, 2].map(|k| p[k] + regularity * (t[k] - p[k]))));
         }
     }
     out
@@ -306,7 +384,7 @@ mod tests {
             max: [10.0; 3],
         };
         let pts = poisson(&region, &|_| 1.5, 3);
-        let reg = regularise(&pts, &region, 1.5, 1.0, 3);
+        let reg = regularise(&pts, &region, 1.5, 1.0, 3, false);
         let a = 2f64.cbrt() * 1.5;
         for p in &reg {
             let u = p.map(|x| x / a);
