@@ -306,6 +306,10 @@ def voronoi(
     periodic: Optional[Value] = None,
     cell_out: Optional[Value] = None,
     density: Optional[Value] = None,
+    density_grade: Optional[Value] = None,
+    density_field: Optional[Value] = None,
+    stiffness_field: Optional[Value] = None,
+    clamp: bool = False,
     radius: Optional[Value] = None,
     thickness: Optional[Value] = None,
     beams: bool = False,
@@ -351,6 +355,18 @@ def voronoi(
     cell_out: Write a periodic net's cell as a strut cell (JSON: nodes in unit-cell coordinates,
         struts), for `strut --cell`, `fill --cell` and `homogenize --cell`
     density: Target volume fraction of solid, in (0, 1) (0.15 when no size is given)
+    density_grade: Grade the density linearly along an axis across the box: AXIS:A:B (as z:0.1:0.4);
+        every whole cell meets the grade at its centre within ±0.01
+    density_field: Grade the density by a field: an expression in x, y, z (mm; as "0.15 +
+        0.1*sin(PI*x/20)"; for fill also d, the depth below the skin), a .npy array of shape (NX,
+        NY, NZ) sampled over the box, corners on its corners, or a .vdb's float grid (named density,
+        or the first) in the part's coordinates, read between its voxels' centres
+    stiffness_field: Grade by stiffness: a field (as --density-field takes) of the Young's modulus
+        wanted, relative to the solid's (E/Es, the mean along the axes); each point's density is the
+        one at which the lattice's unit cell, homogenised (`latvox homogenize`), is that stiff. With
+        --clamp, stiffnesses beyond those of the densities homogenised (TPMS: 0.05 or the least that
+        holds together to 0.8; struts 0.03 to 0.6) take those densities
+    clamp: Hold a density field to the type's feasible range instead of refusing it (reported)
     radius: Strut radius of a net, mm, instead of a density
     thickness: Wall thickness of a sheet, mm, instead of a density
     beams: Write the net as beams (3MF Beam Lattice extension: each Voronoi edge a beam of the

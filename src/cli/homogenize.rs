@@ -299,7 +299,7 @@ fn print_summary(name: &str, s: &Settings, h: &Homogenized) {
     outln!("stiffness C, Voigt order xx yy zz yz xz xy (engineering shears):");
     for row in &h.stiffness {
         let cells: Vec<String> = row.iter().map(|v| format!("{:>12}", sig(*v))).collect();
-        outln!("  {}", cells.join(""));
+        outln!("  {}", cells.join(" "));
     }
     let k = &h.constants;
     let rel = |v: f64| v / m.young;

@@ -246,7 +246,7 @@ fn print_beams_summary(r: &BeamsReport) {
     }
 }
 
-fn print_summary(r: &StrutReport) {
+pub(crate) fn print_summary(r: &StrutReport) {
     let cells = r.cells.map(|x| human(x, 2)).join("×");
     outln!(
         "{} struts · {cells} cells of {} mm · {} voxels/cell ({} mm)",

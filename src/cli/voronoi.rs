@@ -2,7 +2,9 @@
 //! Voronoi diagram of random seeds — at an exact volume fraction, strut radius or wall thickness.
 
 use super::command::{job, parsed, Command, PartKeys};
-use super::lattice::{human, named_field, print_density, print_part, triple, MeshArgs, PartArgs};
+use super::lattice::{
+    human, named_field, print_density, print_part, triple, GradeArgs, MeshArgs, PartArgs,
+};
 use super::out::outln;
 use super::part::Part;
 use super::{
@@ -40,6 +42,9 @@ Examples:
   latvox voronoi --spacing 3 --periodic 12 --density 0.15 --size 48 -r 10 -o big.stl --cell-out foam-cell.json
   latvox strut --cell foam-cell.json --cell-size 12 --density 0.2 --size 24 -r 40 -o denser.stl
 
+  # A periodic net graded from 10 % at z = 0 to 30 % at z = 36, cell by repeating cell
+  latvox voronoi --spacing 3 --periodic 9 --density-grade z:0.1:0.3 --size 18,18,36 -r 10 -o graded-net.stl
+
   # Your own seeds (x,y,z per line, mm), and the seeds a run used written out
   latvox voronoi --spacing 3 --density 0.15 --seeds-out seeds.csv -o a.stl
   latvox voronoi --seeds-in seeds.csv --density 0.2 -o b.stl
@@ -67,6 +72,10 @@ pub(crate) const COMMAND: Command = Command {
             "seeds-in",
             "periodic",
             "density",
+            "density-grade",
+            "density-field",
+            "stiffness-field",
+            "clamp",
             "radius",
             "thickness",
             "size",
@@ -138,8 +147,12 @@ pub struct VoronoiArgs {
     #[arg(long, value_name = "FILE.json", requires = "periodic")]
     pub cell_out: Option<PathBuf>,
     /// Target volume fraction of solid, in (0, 1) (0.15 when no size is given).
-    #[arg(long, short = 'd', value_parser = parse_density, allow_hyphen_values = true, conflicts_with_all = ["radius", "thickness"])]
+    #[arg(long, short = 'd', value_parser = parse_density, allow_hyphen_values = true, conflicts_with_all = ["radius", "thickness", "density_grade", "density_field", "stiffness_field"])]
     pub density: Option<f64>,
+    /// A density that varies through the part (a periodic net, --periodic): met cell by cell
+    /// of the repeating cell, as for strut lattices.
+    #[command(flatten)]
+    pub grade: GradeArgs,
     /// Strut radius of a net, mm, instead of a density.
     #[arg(long, value_name = "MM", value_parser = parse_positive, allow_hyphen_values = true, conflicts_with = "thickness")]
     pub radius: Option<f64>,
@@ -178,6 +191,9 @@ impl latvox::batch::Task for VoronoiArgs {
                 latvox::batch::TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
             }
             Made::Beams(r) => latvox::batch::TaskReport::new(&r, &r.verdict(), Vec::new()),
+            Made::Graded(r) => {
+                latvox::batch::TaskReport::new(&r, &r.verdict(), r.part.warnings.clone())
+            }
         }
     }
 }
@@ -244,6 +260,8 @@ impl VoronoiArgs {
 pub enum Made {
     /// The part as a mesh.
     Mesh(Box<VoronoiReport>),
+    /// A graded periodic net, made as a graded strut lattice.
+    Graded(Box<latvox::strut::StrutReport>),
     /// The net as 3MF beams.
     Beams(Box<VoronoiBeamsReport>),
 }
@@ -254,6 +272,11 @@ pub fn run(a: &VoronoiArgs, quiet: bool) -> Result<i32> {
         Made::Mesh(report) => {
             let code = a.mesh.finish(&report, &report.part)?;
             print_summary(a, &report);
+            Ok(code)
+        }
+        Made::Graded(report) => {
+            let code = a.mesh.finish(&report, &report.part)?;
+            super::strut::print_summary(&report);
             Ok(code)
         }
         Made::Beams(report) => {
@@ -305,6 +328,9 @@ pub fn execute(a: &VoronoiArgs, progress: &latvox::progress::Progress) -> Result
             "--cell-out writes a periodic net's struts: a sheet's walls are not a strut cell",
         ));
     }
+    if let Some(r) = graded(a, &job, progress)? {
+        return Ok(Made::Graded(Box::new(r)));
+    }
     if a.beams {
         if matches!(a.structure, StructureArg::Sheet) {
             return Err(latvox::Error::invalid(
@@ -326,6 +352,55 @@ pub fn execute(a: &VoronoiArgs, progress: &latvox::progress::Progress) -> Result
         latvox::io::atomic::write_atomic(path, |w| w.write_all(json.as_bytes()))?;
     }
     Ok(Made::Mesh(Box::new(report)))
+}
+
+/// A graded periodic net: its cell made as a strut lattice graded cell by repeating cell (the
+/// strut job's grading); `None` when no grading is asked for.
+fn graded(
+    a: &VoronoiArgs,
+    job: &VoronoiJob,
+    progress: &latvox::progress::Progress,
+) -> Result<Option<latvox::strut::StrutReport>> {
+    let g = &a.grade;
+    if g.density_grade.is_none() && g.density_field.is_none() && g.stiffness_field.is_none() {
+        return Ok(None);
+    }
+    let (Some(period), StructureArg::Net, false) = (a.periodic, a.structure, a.beams) else {
+        return Err(latvox::Error::invalid(
+            "a graded Voronoi foam is a periodic net (--periodic, --structure net), written as a mesh: give --periodic, or one --density",
+        ));
+    };
+    let (foam, spacing) = job.foam(progress)?;
+    let family = job
+        .net_cell(&foam)?
+        .ok_or_else(|| latvox::Error::invalid("the foam is not a periodic net"))?;
+    let cell = family.part.cell.clone();
+    let grading = g.grading(&job.bounds, || {
+        Ok(latvox::homogenize::Cell {
+            lattice: latvox::homogenize::Lattice::Strut(cell.clone()),
+            size: [period; 3],
+        })
+    })?;
+    let strut = latvox::strut::StrutJob {
+        cell: cell.clone(),
+        cell_name: format!("periodic Voronoi net ({} seeds a cell)", foam.stats.cells),
+        sizing: latvox::strut::Sizing::Density(0.5),
+        blend: 0.0,
+        domain: latvox::field::Domain::from_size_and_cell(a.size, [period; 3], a.origin)?,
+        resolution: job.cell_voxels(spacing, job.resolution),
+        auto_resolution: job.auto_resolution,
+        options: job.options,
+        grading,
+    };
+    let report = a
+        .mesh
+        .write(|sink| strut.run_into(progress, sink), |r| &mut r.part)?;
+    write_seeds(a, foam.own_seeds())?;
+    if let Some(path) = &a.cell_out {
+        let json = cell.to_json();
+        latvox::io::atomic::write_atomic(path, |w| w.write_all(json.as_bytes()))?;
+    }
+    Ok(Some(report))
 }
 
 fn print_summary(a: &VoronoiArgs, r: &VoronoiReport) {

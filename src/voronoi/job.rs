@@ -349,7 +349,7 @@ impl VoronoiJob {
     }
 
     /// Voxels across a periodic cell at `resolution` voxels per spacing: whole leaves.
-    fn cell_voxels(&self, spacing: [f64; 2], resolution: u32) -> u32 {
+    pub fn cell_voxels(&self, spacing: [f64; 2], resolution: u32) -> u32 {
         let leaf = instance::BLOCK as f64;
         let l = self.period.unwrap_or(spacing[0]);
         ((resolution as f64 * l / spacing[0] / leaf).ceil() * leaf) as u32

@@ -381,6 +381,18 @@ fn bad_settings_are_refused() {
             "--spacing-field",
         ),
         (&["--cell-out", "c.json"], "--periodic"),
+        (&["--density-grade", "z:0.1:0.3"], "periodic net"),
+        (
+            &[
+                "--periodic",
+                "9",
+                "--structure",
+                "sheet",
+                "--density-field",
+                "0.2",
+            ],
+            "periodic net",
+        ),
         (
             &[
                 "--structure",
