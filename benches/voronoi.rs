@@ -37,6 +37,7 @@ fn scale(n: u32) {
         },
         resolution: 10,
         period: Some(12.0),
+        pores: 0.0,
         auto_resolution: false,
         options: Options {
             verify: latvox::verify::Verify::Full,

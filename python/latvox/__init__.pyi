@@ -312,6 +312,7 @@ def voronoi(
     clamp: bool = False,
     radius: Optional[Value] = None,
     thickness: Optional[Value] = None,
+    pores: Optional[Value] = None,
     beams: bool = False,
     size: Optional[Value] = None,
     origin: Optional[Value] = None,
@@ -369,6 +370,9 @@ def voronoi(
     clamp: Hold a density field to the type's feasible range instead of refusing it (reported)
     radius: Strut radius of a net, mm, instead of a density
     thickness: Wall thickness of a sheet, mm, instead of a density
+    pores: Open a sheet's cells: a round pore through the middle of each wall, this fraction of the
+        wall's inradius (0 to 1; walls too small for a pore two voxels across keep none) (default:
+        0)
     beams: Write the net as beams (3MF Beam Lattice extension: each Voronoi edge a beam of the
         radius, the box a clipping mesh) instead of a mesh. The output must be .3mf
     size: Box size in mm: S or SX,SY,SZ (default: 20)

@@ -24,8 +24,10 @@ Examples:
   # A 20 mm cube of Voronoi struts, cells of 3 mm on average, at exactly 15 % density
   latvox voronoi --spacing 3 --density 0.15 --size 20 -o foam.stl --report foam.json
 
-  # Walls 0.3 mm thick along the Voronoi faces, in a 30×20×10 mm plate
+  # Walls 0.3 mm thick along the Voronoi faces, in a 30×20×10 mm plate; with --pores 0.5,
+  # a round hole through each wall half its inradius wide, so that the cells drain
   latvox voronoi --structure sheet --spacing 4 --thickness 0.3 --size 30,20,10 -o walls.stl
+  latvox voronoi --structure sheet --spacing 4 --thickness 0.3 --pores 0.5 --size 20 -o open.stl
 
   # Cells graded from 2 mm at x = 0 to 5 mm at x = 30 (the spacing is an expression in x, y, z)
   latvox voronoi --spacing-field '2 + x/10' --density 0.2 --size 30,10,10 -o graded.stl
@@ -56,7 +58,7 @@ than a voxel merged. With --density, latvox finds the strut radius (net) or wall
 (sheet) at which the written mesh has that volume fraction; members under 2 voxels across
 raise the resolution (--resolution counts voxels per spacing, the smallest where it varies);
 sizes at which one pore in ten closes are refused, with the range the foam allows. A sheet's
-cells are closed: each is a void of its own. With --periodic, the seeds fill one cell (from the
+cells are closed, each a void of its own, unless --pores opens a hole through each wall. With --periodic, the seeds fill one cell (from the
 box's lower corner) measured with their copies in the cells round it, so the foam tiles space;
 a periodic net is a strut lattice whose cell --cell-out writes (for strut, fill, homogenize).";
 
@@ -78,6 +80,7 @@ pub(crate) const COMMAND: Command = Command {
             "clamp",
             "radius",
             "thickness",
+            "pores",
             "size",
             "origin",
         ],
@@ -159,6 +162,10 @@ pub struct VoronoiArgs {
     /// Wall thickness of a sheet, mm, instead of a density.
     #[arg(long, value_name = "MM", value_parser = parse_positive, allow_hyphen_values = true)]
     pub thickness: Option<f64>,
+    /// Open a sheet's cells: a round pore through the middle of each wall, this fraction of the
+    /// wall's inradius (0 to 1; walls too small for a pore two voxels across keep none).
+    #[arg(long, value_name = "F", default_value_t = 0.0, value_parser = parse_unit)]
+    pub pores: f64,
     /// Write the net as beams (3MF Beam Lattice extension: each Voronoi edge a beam of the
     /// radius, the box a clipping mesh) instead of a mesh. The output must be .3mf.
     #[arg(long)]
@@ -249,6 +256,7 @@ impl VoronoiArgs {
             },
             bounds,
             period: self.periodic,
+            pores: self.pores,
             resolution: self.mesh.resolution,
             auto_resolution: !self.mesh.fixed_resolution,
             options: self.mesh.options(),
@@ -438,6 +446,13 @@ fn print_summary(a: &VoronoiArgs, r: &VoronoiReport) {
         f.edge_length.p5,
         f.edge_length.p95
     );
+    if a.pores > 0.0 {
+        outln!(
+            "pores     {} walls in the box opened by a round pore ({} of the wall's inradius)",
+            f.pores,
+            human(a.pores, 3)
+        );
+    }
     let p = &r.part;
     print_density(p);
     print_part(p);

@@ -83,6 +83,9 @@ pub struct VoronoiJob {
     /// The edge of a cell that the foam repeats with, mm, starting at the box's lower corner
     /// (a periodic foam); `None` for a foam random through the whole box.
     pub period: Option<f64>,
+    /// A sheet's pores: a round hole through each wall, this fraction (0 to 1) of the wall's
+    /// inradius; 0 for closed cells.
+    pub pores: f64,
     /// Raise the resolution when members would be too thin for the voxels.
     pub auto_resolution: bool,
     /// The pipeline's options.
@@ -226,6 +229,20 @@ impl VoronoiJob {
         let s = self.bounds.size();
         if !s.iter().all(|x| *x > 0.0 && x.is_finite()) {
             return Err(Error::invalid("the box must have a positive size"));
+        }
+        if !(0.0..1.0).contains(&self.pores) {
+            return Err(Error::setting(
+                "pores",
+                format!(
+                    "pores must be in [0, 1): a fraction of each wall's inradius, got {}",
+                    self.pores
+                ),
+            ));
+        }
+        if self.pores > 0.0 && self.structure == Structure::Net {
+            return Err(Error::invalid(
+                "--pores opens a sheet's walls: a net is open already",
+            ));
         }
         if let Some(l) = self.period {
             match &self.seeding {
@@ -509,6 +526,11 @@ impl VoronoiJob {
                 Foam::new(self.structure, cell, copies, voxel, spacing[1])?.repeating([l; 3])
             }
             None => Foam::new(self.structure, self.bounds, seeds, voxel, spacing[1])?,
+        };
+        // Pores narrower than the thinnest member would be a voxel's notch, not a hole.
+        let foam = match self.pores {
+            f if f > 0.0 => foam.with_pores(f, self.min_level(voxel)),
+            _ => foam,
         };
         Ok((foam, spacing))
     }

@@ -22,6 +22,9 @@ fn case(rng: &mut Rng, n: u64, dir: &Path) -> Option<String> {
     let seed = rng.next() % 1000;
     // One foam in three repeats with a cell of two to three and a half spacings.
     let periodic = (rng.below(3) == 0).then(|| format!("{:.3}", spacing * rng.uniform(2.0, 3.5)));
+    // One sheet in three has pores.
+    let pores = (structure == "sheet" && rng.below(3) == 0)
+        .then(|| format!("{:.2}", rng.uniform(0.3, 0.8)));
     let f = |v: [f64; 3]| format!("{:.3},{:.3},{:.3}", v[0], v[1], v[2]);
     let (size_s, origin_s) = (f(size), f(origin));
     let (spacing_s, density_s, res_s, seed_s) = (
@@ -56,6 +59,9 @@ fn case(rng: &mut Rng, n: u64, dir: &Path) -> Option<String> {
     ];
     if let Some(p) = &periodic {
         args.extend(["--periodic", p]);
+    }
+    if let Some(p) = &pores {
+        args.extend(["--pores", p]);
     }
     let what = format!("case {n}: {}", args.join(" "));
     let out = run(&args, dir);
@@ -188,6 +194,89 @@ fn scipy_voronoi_of_the_same_seeds_lies_inside_the_members() {
         assert_eq!(r["members_inside"], r["member_points"], "{structure}: {r}");
         assert!(r["seeds"].as_u64().unwrap() >= 20, "{structure}: {r}");
         assert_eq!(r["seeds_outside"], r["seeds"], "{structure}: {r}");
+    }
+}
+
+/// `--pores`: a sheet's walls each get a round hole, so its cells drain (no enclosed void where
+/// the closed sheet has one per cell) and the centroids of SciPy's faces of the same seeds lie
+/// outside the solid (in the holes: faces whose pore, 0.6 of their inradius, is well over the
+/// two voxels a pore needs), at the density asked, valid by CGAL, one piece.
+#[test]
+fn pores_open_a_sheets_cells() {
+    let dir = tempdir();
+    let d = dir.path();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference/voronoi.py");
+    for pores in ["0", "0.6"] {
+        let (out, rep) = (format!("p{pores}.stl"), format!("p{pores}.json"));
+        ok(
+            &[
+                "voronoi",
+                "--structure",
+                "sheet",
+                "--spacing",
+                "3",
+                "--size",
+                "12",
+                "--density",
+                "0.25",
+                "--pores",
+                pores,
+                "--resolution",
+                "16",
+                "--verify",
+                "cgal",
+                "-q",
+                "--seeds-out",
+                "seeds.csv",
+                "-o",
+                &out,
+                "--report",
+                &rep,
+            ],
+            d,
+        );
+        let r = json(&d.join(&rep));
+        let tris = read_stl(&d.join(&out));
+        let measured = volume(&tris) / 1728.0;
+        assert!(
+            (measured - 0.25).abs() <= 0.002,
+            "pores {pores}: {measured}"
+        );
+        let checks = &r["checks"];
+        assert!(
+            checks["checked_by"] == "CGAL"
+                && checks["closed"] == true
+                && checks["self_intersecting"] == false,
+            "pores {pores}: {checks}"
+        );
+        assert_eq!(pieces(&tris), 1, "pores {pores}");
+        let voids = r["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("voids"));
+        assert_eq!(voids, pores == "0", "pores {pores}: {}", r["warnings"]);
+        let o = std::process::Command::new("python3")
+            .arg(&script)
+            // Pores of 0.6 × 0.8 mm = 0.48 mm or more, against the least of 2 voxels, 0.375 mm.
+            .args(["seeds.csv", &out, "pores", "0.8", "0.6"])
+            .args(["0", "0", "0", "12", "12", "12"])
+            .current_dir(d)
+            .output()
+            .expect("python3 with numpy and scipy (scripts/install-deps.sh --tests)");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        eprintln!("pores {pores}: {s}");
+        let (n, inside) = (
+            s["member_points"].as_u64().unwrap() as f64,
+            s["members_inside"].as_u64().unwrap() as f64,
+        );
+        assert!(n >= 40.0, "{s}");
+        if pores == "0" {
+            assert_eq!(inside, n, "closed walls hold every centroid: {s}");
+        } else {
+            assert_eq!(inside, 0.0, "every centroid in a pore: {s}");
+        }
     }
 }
 

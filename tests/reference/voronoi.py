@@ -3,8 +3,9 @@ points sampled on its edges (net) or faces (sheet) well inside the box, and the 
 classified against the written STL by its generalised winding number (Jacobson et al. 2013,
 the Van Oosterom–Strackee solid angle of every triangle), in NumPy.
 
-usage: voronoi.py SEEDS.csv PART.stl net|sheet LEVEL MARGIN X0 Y0 Z0 X1 Y1 Z1 [PERIOD [POINTS]]
-  LEVEL: the strut radius or wall thickness; MARGIN: how far inside the box points are taken;
+usage: voronoi.py SEEDS.csv PART.stl net|sheet|pores LEVEL MARGIN X0 Y0 Z0 X1 Y1 Z1 [PERIOD [POINTS]]
+  pores: the centroids of faces of inradius LEVEL or more (where a sheet's pores are);
+  LEVEL: the strut radius or wall thickness (pores: the least inradius); MARGIN: how far inside the box points are taken;
   PERIOD: the seeds are one cell of this edge from the box's lower corner, repeated through the
   box and a cell round it (a periodic foam); POINTS: how many member points to test (400; half
   as many seeds).
@@ -22,6 +23,12 @@ def read_stl(path):
     n = int.from_bytes(data[80:84], "little")
     rec = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
     return np.frombuffer(data, dtype=rec, count=n, offset=84)["v"].astype(np.float64)
+
+
+def segment_distance(p, a, b):
+    ab = b - a
+    t = np.clip(np.dot(p - a, ab) / max(np.dot(ab, ab), 1e-300), 0.0, 1.0)
+    return float(np.linalg.norm(p - (a + t * ab)))
 
 
 def winding(tris, points):
@@ -66,10 +73,18 @@ def main():
                     continue
                 for t in (0.3, 0.5, 0.7):
                     members.append(a + t * (b - a))
-        else:
+        elif structure == "sheet":
             centre = poly.mean(axis=0)
             members.append(centre)
             members.extend(centre + 0.5 * (v - centre) for v in poly)
+        else:
+            # "pores": the centroids of the faces whose inradius (from the centroid) is at
+            # least LEVEL, where the pores are.
+            centre = poly.mean(axis=0)
+            inradius = min(segment_distance(centre, a, b)
+                           for a, b in zip(poly, np.roll(poly, -1, axis=0)))
+            if inradius >= level:
+                members.append(centre)
     members = [p for p in members if within(p)]
     # Some hundreds of points spread over the box are plenty: keep the test quick.
     n = int(sys.argv[13]) if len(sys.argv) > 13 else 400

@@ -32,6 +32,7 @@ use crate::lattice::model::LevelModel;
 use crate::lattice::strut::beams::segment_box_distance;
 use crate::mesh::pipeline::{Family, Solid};
 use kiddo::{KdTree, SquaredEuclidean};
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// Points of the density model.
@@ -110,6 +111,8 @@ pub struct FoamStats {
     pub edge_length: Spread,
     /// Voronoi edges merged away as shorter than the merge length.
     pub edges_merged: usize,
+    /// A sheet's walls in the box with a pore through them (`--pores`).
+    pub pores: usize,
 }
 
 /// A Voronoi foam in a box.
@@ -135,6 +138,32 @@ pub struct Foam {
     /// The cell the foam repeats with, from the box's lower corner (a periodic foam: its box is
     /// that cell, and its seeds the cell's followed by their copies in the 26 cells round it).
     pub period: Option<Vec3>,
+    /// A sheet's pores: a round hole through each wall, by the pair of seeds the wall is
+    /// between.
+    pores: HashMap<(u32, u32), Pore>,
+}
+
+/// A round hole through a wall: its centre (the face's centroid), the wall's unit normal and
+/// its radius, mm.
+#[derive(Debug, Clone, Copy)]
+pub struct Pore {
+    /// The face's centroid.
+    pub centre: Vec3,
+    /// The wall's unit normal.
+    pub normal: Vec3,
+    /// The hole's radius.
+    pub radius: f64,
+}
+
+impl Pore {
+    /// Positive inside the hole (within its radius of the axis and `depth` of the face), the
+    /// least distance to leaving it.
+    fn inside(&self, p: Vec3, depth: f64) -> f64 {
+        let v = sub(p, self.centre);
+        let a = (0..3).map(|k| v[k] * self.normal[k]).sum::<f64>();
+        let r = (norm(v).powi(2) - a * a).max(0.0).sqrt();
+        (self.radius - r).min(depth - a.abs())
+    }
 }
 
 impl std::fmt::Debug for Foam {
@@ -209,6 +238,7 @@ impl Foam {
                     .collect(),
             ),
             edges_merged: raw.edges.len() - diagram.edges.len(),
+            pores: 0,
         };
         let mut foam = Foam {
             structure,
@@ -221,6 +251,7 @@ impl Foam {
             stats,
             reach,
             period: None,
+            pores: HashMap::new(),
         };
         foam.model = foam.measure_model();
         foam.closing = foam.closing_level();
@@ -239,6 +270,53 @@ impl Foam {
             period: Some(size),
             ..self
         }
+    }
+
+    /// The foam with a round pore through each wall of a sheet, its radius `fraction` of the
+    /// face's inradius (from its centroid); none where that is under `least` mm. The density
+    /// model is measured again with them.
+    pub fn with_pores(mut self, fraction: f64, least: f64) -> Foam {
+        let d = &self.diagram;
+        let near = self.bounds.grown(self.reach);
+        let mut pores = HashMap::new();
+        for f in &d.faces {
+            let pts: Vec<Vec3> = f.vertices.iter().map(|&v| d.vertices[v as usize]).collect();
+            let n = pts.len() as f64;
+            let c = [0, 1, 2].map(|k| pts.iter().map(|p| p[k]).sum::<f64>() / n);
+            if !near.contains(c) {
+                continue;
+            }
+            let inradius = (0..pts.len())
+                .map(|i| segment_distance(c, pts[i], pts[(i + 1) % pts.len()]))
+                .fold(f64::INFINITY, f64::min);
+            let radius = fraction * inradius;
+            let axis = sub(d.seeds[f.seeds[1] as usize], d.seeds[f.seeds[0] as usize]);
+            let len = norm(axis);
+            if radius < least || len <= 0.0 {
+                continue;
+            }
+            let key = (f.seeds[0].min(f.seeds[1]), f.seeds[0].max(f.seeds[1]));
+            pores.insert(
+                key,
+                Pore {
+                    centre: c,
+                    normal: axis.map(|x| x / len),
+                    radius,
+                },
+            );
+        }
+        self.stats.pores = pores
+            .values()
+            .filter(|p: &&Pore| self.bounds.contains(p.centre))
+            .count();
+        self.pores = pores;
+        self.model = self.measure_model();
+        self
+    }
+
+    /// The pores through the walls.
+    pub fn pores(&self) -> impl Iterator<Item = &Pore> {
+        self.pores.values()
     }
 
     /// The seeds that make the foam: all of them, or a periodic foam's cell's own.
@@ -303,30 +381,44 @@ impl Foam {
         BeamField::new(&self.beams(radius), &[], reach)
     }
 
-    /// The distance from `p` to the nearest Voronoi face, up to `cap`.
-    pub fn face_distance(&self, p: Vec3, cap: f64) -> f64 {
+    /// The distance from `p` to the nearest Voronoi face, up to `cap`, and that face's pore
+    /// when it has one.
+    pub fn face_distance(&self, p: Vec3, cap: f64) -> (f64, Option<&Pore>) {
         let nn = self.tree.nearest_one::<SquaredEuclidean>(&p);
         let s1 = self.diagram.seeds[nn.item as usize];
         let a2 = nn.distance;
         let r = a2.sqrt() + 2.0 * cap;
-        let mut d = cap;
+        let (mut d, mut other) = (cap, None);
         for nb in self.tree.within_unsorted::<SquaredEuclidean>(&p, r * r) {
             if nb.item == nn.item {
                 continue;
             }
             let c = norm(sub(self.diagram.seeds[nb.item as usize], s1));
-            if c > 0.0 {
-                d = d.min((nb.distance - a2) / (2.0 * c));
+            if c > 0.0 && (nb.distance - a2) / (2.0 * c) < d {
+                d = (nb.distance - a2) / (2.0 * c);
+                other = Some(nb.item as u32);
             }
         }
-        d.max(0.0)
+        (d.max(0.0), other.and_then(|j| self.pore(nn.item as u32, j)))
     }
 
-    /// The level at which the solid holds the point `p`.
+    /// The pore through the wall between seeds `i` and `j`.
+    fn pore(&self, i: u32, j: u32) -> Option<&Pore> {
+        if self.pores.is_empty() {
+            return None;
+        }
+        self.pores.get(&(i.min(j), i.max(j)))
+    }
+
+    /// The level at which the solid holds the point `p` (never, within a pore's radius of its
+    /// axis).
     fn level_holding(&self, p: Vec3, skeleton: &BeamField) -> f64 {
         match self.structure {
             Structure::Net => skeleton.value(p).max(0.0),
-            Structure::Sheet => 2.0 * self.face_distance(p, self.reach),
+            Structure::Sheet => match self.face_distance(p, self.reach) {
+                (_, Some(pore)) if pore.inside(p, f64::INFINITY) > 0.0 => self.reach,
+                (d, _) => 2.0 * d,
+            },
         }
     }
 
@@ -439,11 +531,9 @@ impl SheetField<'_> {
             .distance
             .sqrt();
         let r = a + 2.0 * spread + 2.0 * cap;
-        let near: Vec<Vec3> = tree
-            .within_unsorted::<SquaredEuclidean>(&centre, r * r)
-            .iter()
-            .map(|n| seeds[n.item as usize])
-            .collect();
+        let found = tree.within_unsorted::<SquaredEuclidean>(&centre, r * r);
+        let near: Vec<Vec3> = found.iter().map(|n| seeds[n.item as usize]).collect();
+        let index: Vec<u32> = found.iter().map(|n| n.item as u32).collect();
         let d2 = |p: Vec3, s: Vec3| (0..3).map(|k| (p[k] - s[k]).powi(2)).sum::<f64>();
         for (p, o) in points.iter().zip(out.iter_mut()) {
             let (mut best, mut i1) = (f64::INFINITY, 0);
@@ -455,27 +545,45 @@ impl SheetField<'_> {
                 }
             }
             let s1 = near[i1];
-            let mut d = cap;
+            let (mut d, mut other) = (cap, None);
             for (i, s) in near.iter().enumerate() {
                 if i != i1 {
                     let c = d2(*s, s1).sqrt();
-                    if c > 0.0 {
-                        d = d.min((d2(*p, *s) - best) / (2.0 * c));
+                    if c > 0.0 && (d2(*p, *s) - best) / (2.0 * c) < d {
+                        d = (d2(*p, *s) - best) / (2.0 * c);
+                        other = Some(i);
                     }
                 }
             }
-            *o = (d - self.half).min(self.reach);
+            let wall = d - self.half;
+            // A pore cuts the wall through, and the narrow band beyond it.
+            let hole = other
+                .and_then(|j| self.foam.pore(index[i1], index[j]))
+                .map_or(f64::NEG_INFINITY, |pore| {
+                    pore.inside(*p, self.half + self.reach)
+                });
+            *o = wall.max(hole).min(self.reach);
         }
     }
 }
 
 impl Field for SheetField<'_> {
     fn value(&self, p: Vec3) -> f64 {
-        (self.foam.face_distance(p, self.half + self.reach) - self.half).min(self.reach)
+        let mut out = [0.0];
+        self.values_near(p, 0.0, &[p], &mut out);
+        out[0]
     }
 
     fn clearance(&self, p: Vec3) -> f64 {
         self.value(p).abs()
+    }
+
+    /// Not where a pore cuts its wall: its rim is a crease that snapping would fold.
+    fn smooth_near(&self, p: Vec3, reach: f64) -> bool {
+        match self.foam.face_distance(p, self.half + self.reach) {
+            (_, Some(pore)) => pore.inside(p, self.half + reach) < -reach,
+            _ => true,
+        }
     }
 
     fn values(&self, points: &[Vec3], out: &mut [f64]) {
@@ -522,6 +630,10 @@ struct Repeated<'a> {
 impl Field for Repeated<'_> {
     fn value(&self, p: Vec3) -> f64 {
         self.inner.value(wrap(p, &self.cell))
+    }
+
+    fn smooth_near(&self, p: Vec3, reach: f64) -> bool {
+        self.inner.smooth_near(wrap(p, &self.cell), reach)
     }
 
     fn clearance(&self, p: Vec3) -> f64 {
