@@ -54,7 +54,7 @@ pub fn check_cell(size: Vec3, spacing: f64) -> Result<()> {
         return Err(Error::setting(
             "periodic",
             format!(
-                "a periodic cell of {period} mm is under {MIN_SPACINGS} spacings of {spacing} mm: give --periodic {} or more",
+                "a periodic cell of {period} mm is under {MIN_SPACINGS} spacings of {spacing} mm: make the cell {} mm or more, or the spacing smaller",
                 MIN_SPACINGS * spacing
             ),
         ));
@@ -64,7 +64,7 @@ pub fn check_cell(size: Vec3, spacing: f64) -> Result<()> {
         return Err(Error::setting(
             "periodic",
             format!(
-                "a periodic cell of {period} mm holds about {n:.0} seeds of spacing {spacing} mm, more than {MAX_CELL_SEEDS}: give a smaller cell (up to {:.1} mm); it repeats through any box",
+                "a periodic cell of {period} mm holds about {n:.0} seeds of spacing {spacing} mm, more than {MAX_CELL_SEEDS}: make the cell up to {:.1} mm (it repeats through any box) or the spacing larger",
                 spacing * (MAX_CELL_SEEDS as f64).cbrt()
             ),
         ));
