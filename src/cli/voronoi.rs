@@ -379,10 +379,7 @@ fn graded(
         ));
     };
     let (foam, spacing) = job.foam(progress)?;
-    let family = job
-        .net_cell(&foam)?
-        .ok_or_else(|| latvox::Error::invalid("the foam is not a periodic net"))?;
-    let cell = family.part.cell.clone();
+    let cell = Arc::new(latvox::lattice::voronoi::periodic::net_cell(&foam)?);
     let grading = g.grading(&job.bounds, || {
         Ok(latvox::homogenize::Cell {
             lattice: latvox::homogenize::Lattice::Strut(cell.clone()),

@@ -709,7 +709,6 @@ impl VoronoiJob {
     /// at, in tiles beyond [`crate::render::MODEL_MEMORY`]; for slices moved so that it encloses
     /// the mesh's volume). Other foams are drawn from their mesh.
     pub fn model(&self, fidelity: crate::render::Fidelity) -> Result<crate::render::Model> {
-        self.validate()?;
         let (foam, spacing) = self.foam(&Progress::hidden())?;
         let Some(family) = self.net_cell(&foam)? else {
             return Err(Error::invalid(

@@ -131,6 +131,20 @@ fn long_random_foams_meet_their_density_closed_and_in_one_piece() {
     property(0x5eed_f0a5, 24);
 }
 
+/// Runs `tests/reference/voronoi.py` (SciPy's Voronoi diagram of the seeds, points classified
+/// against the part by winding number) in `dir` with `args`; its JSON.
+fn scipy_reference(dir: &Path, args: &[&str]) -> serde_json::Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference/voronoi.py");
+    let o = std::process::Command::new("python3")
+        .arg(&script)
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("python3 with numpy and scipy (scripts/install-deps.sh --tests)");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
 /// The same seeds through SciPy's Voronoi diagram (Qhull): points on its edges (net) or faces
 /// (sheet) inside the box lie inside the written solid, the seeds (far from every member)
 /// outside it.
@@ -157,7 +171,6 @@ fn scipy_voronoi_of_the_same_seeds_lies_inside_the_members() {
         ],
         d,
     );
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference/voronoi.py");
     for (structure, flag, level) in [("net", "--radius", "0.3"), ("sheet", "--thickness", "0.4")] {
         let out = format!("{structure}.stl");
         ok(
@@ -179,15 +192,22 @@ fn scipy_voronoi_of_the_same_seeds_lies_inside_the_members() {
             ],
             d,
         );
-        let o = std::process::Command::new("python3")
-            .arg(&script)
-            .args(["seeds.csv", &out, structure, level, "0.6"])
-            .args(["0", "0", "0", "12", "12", "12"])
-            .current_dir(d)
-            .output()
-            .expect("python3 with numpy and scipy (scripts/install-deps.sh --tests)");
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let r = scipy_reference(
+            d,
+            &[
+                "seeds.csv",
+                &out,
+                structure,
+                level,
+                "0.6",
+                "0",
+                "0",
+                "0",
+                "12",
+                "12",
+                "12",
+            ],
+        );
         eprintln!("{structure}: {r}");
         let n = r["member_points"].as_u64().unwrap();
         assert!(n >= 50, "{structure}: only {n} member points");
@@ -205,7 +225,6 @@ fn scipy_voronoi_of_the_same_seeds_lies_inside_the_members() {
 fn pores_open_a_sheets_cells() {
     let dir = tempdir();
     let d = dir.path();
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference/voronoi.py");
     for pores in ["0", "0.6"] {
         let (out, rep) = (format!("p{pores}.stl"), format!("p{pores}.json"));
         ok(
@@ -256,16 +275,23 @@ fn pores_open_a_sheets_cells() {
             .iter()
             .any(|w| w.as_str().unwrap().contains("voids"));
         assert_eq!(voids, pores == "0", "pores {pores}: {}", r["warnings"]);
-        let o = std::process::Command::new("python3")
-            .arg(&script)
-            // Pores of 0.6 × 0.8 mm = 0.48 mm or more, against the least of 2 voxels, 0.375 mm.
-            .args(["seeds.csv", &out, "pores", "0.8", "0.6"])
-            .args(["0", "0", "0", "12", "12", "12"])
-            .current_dir(d)
-            .output()
-            .expect("python3 with numpy and scipy (scripts/install-deps.sh --tests)");
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        // Pores of 0.6 × 0.8 mm = 0.48 mm or more, against the least of 2 voxels, 0.375 mm.
+        let s = scipy_reference(
+            d,
+            &[
+                "seeds.csv",
+                &out,
+                "pores",
+                "0.8",
+                "0.6",
+                "0",
+                "0",
+                "0",
+                "12",
+                "12",
+                "12",
+            ],
+        );
         eprintln!("pores {pores}: {s}");
         let (n, inside) = (
             s["member_points"].as_u64().unwrap() as f64,
@@ -520,7 +546,6 @@ fn bad_settings_are_refused() {
 fn a_periodic_foam_is_copied_from_its_cell_and_is_scipys_foam_in_every_cell() {
     let dir = tempdir();
     let d = dir.path();
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference/voronoi.py");
     for (structure, flag, level, res) in [
         ("net", "--radius", "0.45", "6"),
         ("sheet", "--thickness", "0.85", "6"),
@@ -576,15 +601,13 @@ fn a_periodic_foam_is_copied_from_its_cell_and_is_scipys_foam_in_every_cell() {
         );
         let tris = read_stl(&d.join(&out));
         assert_eq!(pieces(&tris), 1, "{structure}");
-        let o = std::process::Command::new("python3")
-            .arg(&script)
-            .args([&seeds, &out, structure, level, "0.6"])
-            .args(["-3", "1.5", "2", "23", "27.5", "28", "6.5", "200"])
-            .current_dir(d)
-            .output()
-            .expect("python3 with numpy and scipy (scripts/install-deps.sh --tests)");
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let s = scipy_reference(
+            d,
+            &[
+                &seeds, &out, structure, level, "0.6", "-3", "1.5", "2", "23", "27.5", "28", "6.5",
+                "200",
+            ],
+        );
         eprintln!("{structure}: {s}");
         assert!(
             s["member_points"].as_u64().unwrap() >= 150,

@@ -33,7 +33,7 @@ use crate::lattice::strut::beams::segment_box_distance;
 use crate::mesh::pipeline::{Family, Solid};
 use kiddo::{KdTree, SquaredEuclidean};
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// Points of the density model.
 const MODEL_POINTS: usize = 1 << 16;
@@ -127,8 +127,9 @@ pub struct Foam {
     segments: Vec<[Vec3; 2]>,
     /// The seeds, for the walls' field.
     tree: KdTree<f64, 3>,
-    /// Volume fraction against the level.
-    pub model: LevelModel,
+    /// Volume fraction against the level, measured when first asked for (a periodic net's
+    /// strut lattice has its own).
+    model: OnceLock<LevelModel>,
     /// The largest level at which the pores stay open.
     pub closing: f64,
     /// The diagram measured.
@@ -246,14 +247,13 @@ impl Foam {
             diagram,
             segments,
             tree,
-            model: LevelModel::new(Vec::new(), 1.0),
+            model: OnceLock::new(),
             closing: 0.0,
             stats,
             reach,
             period: None,
             pores: HashMap::new(),
         };
-        foam.model = foam.measure_model();
         foam.closing = foam.closing_level();
         Ok(foam)
     }
@@ -274,7 +274,7 @@ impl Foam {
 
     /// The foam with a round pore through each wall of a sheet, its radius `fraction` of the
     /// face's inradius (from its centroid); none where that is under `least` mm. The density
-    /// model is measured again with them.
+    /// model is measured with them.
     pub fn with_pores(mut self, fraction: f64, least: f64) -> Foam {
         let d = &self.diagram;
         let near = self.bounds.grown(self.reach);
@@ -310,8 +310,13 @@ impl Foam {
             .filter(|p: &&Pore| self.bounds.contains(p.centre))
             .count();
         self.pores = pores;
-        self.model = self.measure_model();
+        self.model = OnceLock::new();
         self
+    }
+
+    /// The volume fraction against the level (see the module's notes).
+    pub fn model(&self) -> &LevelModel {
+        self.model.get_or_init(|| self.measure_model())
     }
 
     /// The pores through the walls.
@@ -733,10 +738,10 @@ impl Family for FoamFamily {
     }
 
     fn model_fraction(&self, level: f64) -> f64 {
-        self.foam.model.fraction(level)
+        self.foam.model().fraction(level)
     }
 
     fn model_level(&self, fraction: f64) -> f64 {
-        self.foam.model.level(fraction)
+        self.foam.model().level(fraction)
     }
 }
