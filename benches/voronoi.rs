@@ -39,6 +39,7 @@ fn scale(n: u32) {
         period: Some(12.0),
         pores: 0.0,
         auto_resolution: false,
+        grading: None,
         options: Options {
             verify: latvox::verify::Verify::Full,
             instancing: true,

@@ -364,7 +364,7 @@ fn print_summary(r: &FillReport) {
     }
     let p = &r.part;
     if let Some(g) = &r.grading {
-        print_grading(g, p);
+        print_grading(g, p, "whole cells");
         print_part(p);
         return;
     }

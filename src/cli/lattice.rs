@@ -53,6 +53,13 @@ pub struct GradeArgs {
 }
 
 impl GradeArgs {
+    /// Whether a grading is asked for.
+    pub fn is_graded(&self) -> bool {
+        self.density_grade.is_some()
+            || self.density_field.is_some()
+            || self.stiffness_field.is_some()
+    }
+
     /// The grading asked for over `bounds`, if any; `cell` is the lattice's unit cell, for a
     /// stiffness field.
     pub fn grading(
@@ -115,10 +122,11 @@ pub(crate) fn named_field(
     DensityField::parse_named(spec, bounds, noun)
 }
 
-/// The density line of a graded part's summary.
-pub fn print_grading(g: &GradingReport, p: &PartReport) {
+/// The density line of a graded part's summary; `cells` names what the density is met in
+/// ("whole cells").
+pub fn print_grading(g: &GradingReport, p: &PartReport, cells: &str) {
     outln!(
-        "density   {} ({:.3} to {:.3}) · {} whole cells {} (largest error {:.4}) · part {:.4}",
+        "density   {} ({:.3} to {:.3}) · {} {cells} {} (largest error {:.4}) · part {:.4}",
         g.field,
         g.range[0],
         g.range[1],

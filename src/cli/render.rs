@@ -30,9 +30,9 @@ Examples:
   # The meshed part, ray cast, from the same camera (to compare), with its depth as .npy
   latvox render gyroid.stl -o gyroid-mesh.png --depth gyroid-mesh.npy
 
-A part file (from --save-part of tpms, strut or fill) is rendered from its implicit solid at
-the level its density model gives — no mesh is made, so a part of a million cells renders as
-fast as one of a thousand. A mesh file (.stl, .3mf, .obj, .off, .ply) is ray cast as it is.
+A part file (from --save-part of tpms, strut, voronoi or fill) is rendered from its implicit
+solid at the level its mesh is written at (a filled part's lattice at its unit cell's) — the
+part is never meshed whole, so a part of a million cells renders as fast as one of a thousand. A mesh file (.stl, .3mf, .obj, .off, .ply) is ray cast as it is.
 Angles: the azimuth turns about z from the front (eye on −y, 0°) towards the right (eye on +x,
 90°); the elevation lifts the eye above the xy plane.";
 
@@ -191,7 +191,8 @@ pub fn run(a: &RenderArgs) -> Result<i32> {
             Part::Block(model) => {
                 let field = model.field();
                 let scene =
-                    Implicit::new(&*field, model.bounds(), a.section, model.voxel, model.cell);
+                    Implicit::new(&*field, model.bounds(), a.section, model.voxel, model.cell)
+                        .dropping(&model.loose, model.voxel);
                 views(a, &scene)
             }
             Part::Filled(traced) => {

@@ -265,7 +265,7 @@ pub(crate) fn print_summary(r: &StrutReport) {
     );
     let p = &r.part;
     if let Some(g) = &r.grading {
-        print_grading(g, p);
+        print_grading(g, p, "whole cells");
         print_part(p);
         return;
     }

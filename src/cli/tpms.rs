@@ -484,7 +484,7 @@ fn print_tpms_summary(r: &TpmsReport) {
     );
     let p = &r.part;
     if let Some(g) = &r.grading {
-        print_grading(g, p);
+        print_grading(g, p, "whole cells");
         print_part(p);
         return;
     }

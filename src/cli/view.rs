@@ -59,7 +59,7 @@ pub(crate) const COMMAND: Command = Command::new(
 
 #[derive(Args)]
 pub struct ViewArgs {
-    /// The part file (from --save-part of tpms, strut or fill).
+    /// The part file (from --save-part of tpms, strut, voronoi or fill).
     #[arg(value_name = "PART.toml")]
     pub input: PathBuf,
     /// The port to listen on (0: a free one).
@@ -74,7 +74,7 @@ pub struct ViewArgs {
 pub fn run(a: &ViewArgs) -> Result<i32> {
     if !is_part_file(&a.input) {
         return Err(Error::invalid(format!(
-            "{}: the editor opens part files (.toml, from --save-part of tpms, strut or fill); a mesh is drawn by `latvox render`",
+            "{}: the editor opens part files (.toml, from --save-part of tpms, strut, voronoi or fill); a mesh is drawn by `latvox render`",
             a.input.display()
         )));
     }

@@ -3,7 +3,8 @@
 
 use super::command::{job, parsed, Command, PartKeys};
 use super::lattice::{
-    human, named_field, print_density, print_part, triple, GradeArgs, MeshArgs, PartArgs,
+    human, named_field, print_density, print_grading, print_part, triple, GradeArgs, MeshArgs,
+    PartArgs,
 };
 use super::out::outln;
 use super::part::Part;
@@ -88,9 +89,13 @@ pub(crate) const COMMAND: Command = Command {
     }),
     job: Some(job::<VoronoiArgs>),
     trace: Some(|m, f| {
-        Ok(Part::Block(Box::new(
-            parsed::<VoronoiArgs>(m)?.job()?.model(f)?,
-        )))
+        let a = parsed::<VoronoiArgs>(m)?;
+        if a.grade.is_graded() {
+            return Err(latvox::Error::invalid(
+                "a graded part is drawn and sliced from its mesh: make it with -o part.stl, then render, view or slice part.stl",
+            ));
+        }
+        Ok(Part::Block(Box::new(a.job()?.model(f)?)))
     }),
     choices: Some(|| serde_json::json!({ "structure": ["net", "sheet"] })),
     ..Command::new(
@@ -152,8 +157,8 @@ pub struct VoronoiArgs {
     /// Target volume fraction of solid, in (0, 1) (0.15 when no size is given).
     #[arg(long, short = 'd', value_parser = parse_density, allow_hyphen_values = true, conflicts_with_all = ["radius", "thickness", "density_grade", "density_field", "stiffness_field"])]
     pub density: Option<f64>,
-    /// A density that varies through the part (a periodic net, --periodic): met cell by cell
-    /// of the repeating cell, as for strut lattices.
+    /// A density that varies through the part: a periodic net's met cell by repeating cell, as
+    /// for strut lattices; a random foam's block by block, in blocks of about two spacings.
     #[command(flatten)]
     pub grade: GradeArgs,
     /// Strut radius of a net, mm, instead of a density.
@@ -247,6 +252,24 @@ impl VoronoiArgs {
                 regularity: self.regularity,
             },
         };
+        // A periodic net is graded as a strut lattice, cell by repeating cell (see `graded`);
+        // other foams block by block, by the job itself.
+        let grading = match (self.periodic, structure) {
+            (Some(_), Structure::Net) => None,
+            _ if self.grade.stiffness_field.is_some() => {
+                return Err(latvox::Error::invalid(
+                    "--stiffness-field grades by the homogenised stiffness of a repeating cell: give --periodic with a net, or grade the foam by --density-field",
+                ))
+            }
+            _ => self.grade.grading(&bounds, || {
+                unreachable!("a stiffness field is refused above")
+            })?,
+        };
+        if grading.is_some() && self.beams {
+            return Err(latvox::Error::invalid(
+                "a graded foam is written as a mesh: drop --beams, or give one --density or --radius",
+            ));
+        }
         Ok(VoronoiJob {
             structure,
             seeding,
@@ -259,6 +282,7 @@ impl VoronoiArgs {
             pores: self.pores,
             resolution: self.mesh.resolution,
             auto_resolution: !self.mesh.fixed_resolution,
+            grading,
             options: self.mesh.options(),
         })
     }
@@ -363,21 +387,22 @@ pub fn execute(a: &VoronoiArgs, progress: &latvox::progress::Progress) -> Result
 }
 
 /// A graded periodic net: its cell made as a strut lattice graded cell by repeating cell (the
-/// strut job's grading); `None` when no grading is asked for.
+/// strut job's grading); `None` when no grading is asked for or the foam is not a periodic net
+/// (the job grades those itself).
 fn graded(
     a: &VoronoiArgs,
     job: &VoronoiJob,
     progress: &latvox::progress::Progress,
 ) -> Result<Option<latvox::strut::StrutReport>> {
     let g = &a.grade;
-    if g.density_grade.is_none() && g.density_field.is_none() && g.stiffness_field.is_none() {
+    let (true, Some(period), StructureArg::Net) = (g.is_graded(), a.periodic, a.structure) else {
         return Ok(None);
-    }
-    let (Some(period), StructureArg::Net, false) = (a.periodic, a.structure, a.beams) else {
-        return Err(latvox::Error::invalid(
-            "a graded Voronoi foam is a periodic net (--periodic, --structure net), written as a mesh: give --periodic, or one --density",
-        ));
     };
+    if a.beams {
+        return Err(latvox::Error::invalid(
+            "a graded foam is written as a mesh: drop --beams, or give one --density or --radius",
+        ));
+    }
     let (foam, spacing) = job.foam(progress)?;
     let cell = Arc::new(latvox::lattice::voronoi::periodic::net_cell(&foam)?);
     let grading = g.grading(&job.bounds, || {
@@ -409,9 +434,14 @@ fn graded(
 }
 
 fn print_summary(a: &VoronoiArgs, r: &VoronoiReport) {
+    let mean = if r.grading.is_some() {
+        " on average"
+    } else {
+        ""
+    };
     let (kind, level) = match (r.radius, r.thickness) {
-        (Some(l), _) => ("net", format!("strut radius {l:.4} mm")),
-        (_, Some(l)) => ("sheet", format!("wall thickness {l:.4} mm")),
+        (Some(l), _) => ("net", format!("strut radius {l:.4} mm{mean}")),
+        (_, Some(l)) => ("sheet", format!("wall thickness {l:.4} mm{mean}")),
         _ => ("foam", String::new()),
     };
     let spacing = if r.spacing[0] == r.spacing[1] {
@@ -451,7 +481,15 @@ fn print_summary(a: &VoronoiArgs, r: &VoronoiReport) {
         );
     }
     let p = &r.part;
-    print_density(p);
+    match &r.grading {
+        Some(g) => {
+            let block = r
+                .block
+                .map_or(String::new(), |b| format!(" of {} mm", triple(b)));
+            print_grading(g, p, &format!("blocks{block}"))
+        }
+        None => print_density(p),
+    }
     print_part(p);
     if let Some(s) = &a.seeds_out {
         outln!("seeds     {} written to {}", r.seeds.len(), s.display());

@@ -15,7 +15,7 @@ use crate::geom::bvh::Bvh;
 use crate::geom::{norm, sub};
 use crate::grid::GridSpec;
 use crate::lattice::strut::StrutLattice;
-use crate::lattice::tpms::Lattice;
+use crate::lattice::tpms::Lattice as Tpms;
 use crate::mesh::pieces::Loose;
 use crate::mesh::pipeline::Family;
 use crate::mesh::resolution::Resolved;
@@ -25,7 +25,7 @@ use crate::render::trace::{
     field_normal, field_openness, mesh_hit, sphere_trace, Hit, Scene, Section, Tolerance,
 };
 use crate::render::view::scene::{Fill, Scene as EditorScene, Triangles};
-use crate::render::Periodic;
+use crate::render::Lattice;
 
 /// A filled part as meshes and a lattice, ready to trace.
 pub struct Traced {
@@ -34,7 +34,7 @@ pub struct Traced {
     drains: Vec<Drain>,
     skin: f64,
     blend: f64,
-    lattice: Periodic,
+    lattice: Lattice,
     /// The box of the part and the kept solids.
     pub bounds: Aabb,
     /// The voxel meshing would use, mm.
@@ -97,7 +97,7 @@ impl FillJob {
         let (lattice, level) = match &self.lattice {
             Infilling::Tpms { surface, structure } => {
                 let level = settled.level;
-                let solid = Lattice {
+                let solid = Tpms {
                     surface: *surface,
                     structure: *structure,
                     level,
@@ -105,7 +105,7 @@ impl FillJob {
                     bounds,
                     phase: bounds.min,
                 };
-                (Periodic::Tpms(solid), level)
+                (Lattice::Tpms(solid), level)
             }
             Infilling::Strut { cell } => {
                 let radius = settled.level;
@@ -117,7 +117,7 @@ impl FillJob {
                     bounds,
                     phase: bounds.min,
                 };
-                (Periodic::Struts(solid), radius)
+                (Lattice::Struts(solid), radius)
             }
         };
         Ok(Traced {
@@ -263,7 +263,7 @@ impl Traced {
     }
 
     /// The lattice that fills the part.
-    pub fn lattice(&self) -> &Periodic {
+    pub fn lattice(&self) -> &Lattice {
         &self.lattice
     }
 

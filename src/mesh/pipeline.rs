@@ -453,8 +453,9 @@ pub fn loose<F: Family>(family: &F, m: &Measured, voxel: f64) -> Result<pieces::
 /// that it holds the mesh's volume. A mesh whose vertices lie on a curved surface cuts its
 /// chords, and voxels round the sharp edges where the box cuts the lattice: on thin members the
 /// mesh encloses about a percent less than the exact solid at its level, at 32 voxels a cell.
-/// The exact solid's volume is integrated ([`crate::field::volume`], on steps of `step` mm: no
-/// coarser than [`implicit_step`]) over what was meshed — the whole part, or each template cell times the cells it stands for — less
+/// The exact solid's volume is integrated ([`crate::field::volume::volume_extrapolated`], on
+/// steps of `step` mm and twice that, extrapolated: no coarser than [`implicit_step`]) over
+/// what was meshed — the whole part, or each template cell times the cells it stands for — less
 /// the fragments removed; the level moves by the difference over the solid's growth per level
 /// (the search's last secant, or the family's model), and once more by the secant through the
 /// two exact volumes. The integration holds nothing but its own stack, whatever the part's
@@ -484,7 +485,7 @@ pub fn implicit_level<F: Family>(
             .iter()
             .map(|(b, count)| {
                 let clipped = Intersection { a: &*field, b: *b };
-                *count as f64 * crate::field::volume::volume(&clipped, b, step)
+                *count as f64 * crate::field::volume::volume_extrapolated(&clipped, b, step)
             })
             .sum::<f64>()
             - removed

@@ -52,18 +52,19 @@ pub fn model_options(options: &Options) -> Options {
     }
 }
 
-/// A part as an implicit solid, at the level (a TPMS's `t`, a strut radius) its mesh is written
+/// A part as an implicit solid, at the level (a TPMS's `t`, a strut radius, a foam's radius or
+/// wall thickness) its mesh is written
 /// at — found by the same search, on the same route and voxels — with the fragments its mesh
 /// drops: what rendering and slicing trace instead of a mesh. Its field is unclipped; the box
 /// clips it.
 pub struct Model {
     /// The lattice (its field unclipped; [`Solid::bounds`] is the clipping box).
-    pub lattice: Periodic,
-    /// The TPMS level, or the strut radius (mm), the solid is built at.
+    pub lattice: Lattice,
+    /// The TPMS level, the strut radius or a foam's member size (mm), the solid is built at.
     pub level: f64,
     /// The voxel meshing it would use, mm: the scale of its finest features.
     pub voxel: f64,
-    /// The shortest cell side, mm.
+    /// The shortest cell side (a foam's spacing), mm.
     pub cell: f64,
     /// The volume fraction the part is made to, when it is made to one.
     pub target: Option<f64>,
@@ -74,7 +75,7 @@ pub struct Model {
 impl Model {
     /// A strut lattice's model, its radius found by `found` (the part's search on its mesh):
     /// the radius `given`, or the one the mesh is made to at, for slices
-    /// ([`Fidelity::Exact`]) moved so that the solid encloses the mesh's volume; with the
+    /// ([`Fidelity::Volume`]) moved so that the solid encloses the mesh's volume; with the
     /// fragments the mesh drops.
     pub fn of_struts(
         family: &StrutFamily,
@@ -86,15 +87,41 @@ impl Model {
         let c = family.part.size;
         let cell = c[0].min(c[1]).min(c[2]);
         let step = pipeline::implicit_step(found.voxel, cell);
-        let radius = match given {
-            // A radius given is the part's radius, whatever its mesh encloses.
-            Some(r) => r,
+        Model::of(
+            family,
+            found,
+            given,
+            target,
+            fidelity,
+            [cell, step],
+            |f, r| Lattice::Struts(f.at(r)),
+        )
+    }
+
+    /// The model of any family's part, its level found by `found` (the part's search on its
+    /// mesh): the level `given`, or the one the mesh is made at, for slices
+    /// ([`Fidelity::Volume`]) moved so that the solid encloses the mesh's volume; with the
+    /// fragments the mesh drops. `cell` is the lattice's scale (its shortest cell side, a
+    /// foam's spacing), `step` what [`pipeline::implicit_level`] integrates on, and `lattice`
+    /// the family's solid at a level as the renderer draws it.
+    pub fn of<F: Family>(
+        family: &F,
+        found: &Found,
+        given: Option<f64>,
+        target: Option<f64>,
+        fidelity: Fidelity,
+        [cell, step]: [f64; 2],
+        lattice: impl FnOnce(&F, f64) -> Lattice,
+    ) -> Result<Model> {
+        let level = match given {
+            // A level given is the part's level, whatever its mesh encloses.
+            Some(l) => l,
             None if fidelity == Fidelity::Look => found.best.level,
             None => pipeline::implicit_level(family, &found.best, &found.tried, found.voxel, step),
         };
         Ok(Model {
-            level: radius,
-            lattice: Periodic::Struts(family.at(radius)),
+            level,
+            lattice: lattice(family, level),
             voxel: found.voxel,
             cell,
             target,
@@ -130,22 +157,25 @@ impl Model {
     }
 }
 
-/// A periodic lattice clipped by its box: what a part file describes and the browser editor's
-/// shader draws.
+/// A lattice clipped by its box: what a part file describes and the browser editor's shader
+/// draws.
 #[derive(Debug, Clone)]
-pub enum Periodic {
+pub enum Lattice {
     /// A TPMS lattice.
     Tpms(crate::lattice::tpms::Lattice),
     /// A strut lattice.
     Struts(crate::lattice::strut::StrutLattice),
+    /// A Voronoi foam (a periodic net is a strut lattice).
+    Foam(crate::lattice::voronoi::FoamSolid),
 }
 
-impl Periodic {
+impl Lattice {
     /// The lattice as a solid.
     pub fn solid(&self) -> &(dyn Solid + Send) {
         match self {
-            Periodic::Tpms(l) => l,
-            Periodic::Struts(l) => l,
+            Lattice::Tpms(l) => l,
+            Lattice::Struts(l) => l,
+            Lattice::Foam(f) => f,
         }
     }
 }

@@ -17,6 +17,7 @@
 use super::camera::{dot, Ray};
 use crate::field::{intersection_clearance, Aabb, Field, Vec3};
 use crate::geom::bvh::Bvh;
+use crate::mesh::pieces::Loose;
 
 /// Where a ray meets the scene.
 #[derive(Debug, Clone, Copy)]
@@ -203,7 +204,8 @@ impl Section {
 /// after them is taken to have missed it (it only happens along grazing rays).
 pub const MAX_STEPS: usize = 4096;
 
-/// An implicit solid: a field clipped by a box and, where asked, a section plane.
+/// An implicit solid: a field clipped by a box and, where asked, a section plane; less, where
+/// asked, the fragments its mesh drops.
 pub struct Implicit<'a> {
     field: &'a dyn Field,
     bounds: Aabb,
@@ -212,6 +214,8 @@ pub struct Implicit<'a> {
     step: f64,
     /// The distance over which openness is measured, mm.
     reach: f64,
+    /// The fragments left out, and how far beyond their meshes' shells they reach, mm.
+    loose: Option<(&'a Loose, f64)>,
 }
 
 impl<'a> Implicit<'a> {
@@ -231,12 +235,36 @@ impl<'a> Implicit<'a> {
             section,
             step: 0.1 * voxel,
             reach: cell / 6.0,
+            loose: None,
+        }
+    }
+
+    /// The solid less the fragments `loose` holds (meshed on voxels of `voxel` mm), as its
+    /// mesh is: near or inside the solid, a point within a voxel of a fragment's shell (the
+    /// mesh's chords lie within a voxel of the surface) is outside it, and a ray crosses a
+    /// fragment in steps of half a voxel (fragments lie apart from the part, by definition).
+    pub fn dropping(self, loose: &'a Loose, voxel: f64) -> Implicit<'a> {
+        Implicit {
+            loose: (!loose.is_empty()).then_some((loose, voxel)),
+            ..self
+        }
+    }
+
+    /// The solid's value and clearance at `p`, unclipped: the field's, outside the fragments
+    /// left out.
+    fn unclipped(&self, p: Vec3) -> (f64, f64) {
+        let (f, cf) = self.field.value_and_clearance(p);
+        match self.loose {
+            Some((loose, voxel)) if f < voxel && loose.holds(p, voxel) => {
+                (0.5 * voxel, 0.5 * voxel)
+            }
+            _ => (f, cf),
         }
     }
 
     /// The clipped solid's value and clearance at `p`.
     pub fn value_and_clearance(&self, p: Vec3) -> (f64, f64) {
-        let (f, cf) = self.field.value_and_clearance(p);
+        let (f, cf) = self.unclipped(p);
         let b = self.bounds.value(p);
         let (mut v, mut c) = (f.max(b), intersection_clearance(f, cf, b, b.abs()));
         if let Some(s) = &self.section {
@@ -275,7 +303,7 @@ impl Scene for Implicit<'_> {
         let cap = self.section.is_some_and(|s| {
             let d = s.distance(p);
             d.abs() < self.step + 2.0 * (tol.absolute + tol.per_distance * t)
-                && self.field.value(p) <= d + self.step
+                && self.unclipped(p).0 <= d + self.step
         });
         let normal = match (&self.section, cap) {
             (Some(s), true) => s.normal,

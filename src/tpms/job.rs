@@ -140,7 +140,7 @@ impl TpmsJob {
         };
         Ok(crate::render::Model {
             level,
-            lattice: crate::render::Periodic::Tpms(found.family.at(level)),
+            lattice: crate::render::Lattice::Tpms(found.family.at(level)),
             voxel: found.voxel,
             cell: cell[0].min(cell[1]).min(cell[2]),
             target: Some(self.density),

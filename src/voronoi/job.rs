@@ -14,6 +14,7 @@ use crate::io::threemf::BeamModel;
 use crate::lattice::strut::beams::beams as strut_beams;
 use crate::lattice::strut::{StrutFamily, StrutLattice, UnitCell, MIN_STRUT_VOXELS};
 use crate::lattice::voronoi::{periodic, seeds, Foam, FoamFamily, FoamStats, Structure};
+use crate::mesh::graded::{Grading, GradingReport};
 use crate::mesh::instance;
 use crate::mesh::pipeline::{self, Family, Found, Options, Route};
 use crate::mesh::report::{LevelSearch, PartReport};
@@ -88,6 +89,9 @@ pub struct VoronoiJob {
     pub pores: f64,
     /// Raise the resolution when members would be too thin for the voxels.
     pub auto_resolution: bool,
+    /// A density that varies through the part, met block by block (`sizing` is then not
+    /// used); `None` for one density or member size.
+    pub grading: Option<Grading>,
     /// The pipeline's options.
     pub options: Options,
 }
@@ -140,6 +144,12 @@ pub struct VoronoiReport {
     /// The diagram: cells, their sizes, edge lengths (of one repeating cell, for a periodic
     /// foam).
     pub foam: FoamStats,
+    /// A graded part's field and its blocks' densities (`cells` lists the blocks).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grading: Option<GradingReport>,
+    /// The blocks a graded foam's density is met in, from the box's lower corner, mm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub block: Option<Vec3>,
     /// The part as written.
     #[serde(flatten)]
     pub part: PartReport,
@@ -358,7 +368,7 @@ impl VoronoiJob {
 
     /// The voxel edge at `resolution` voxels per spacing: for a periodic foam, rounded down so
     /// that a cell spans whole OpenVDB leaves (the part is then copied from a template).
-    fn voxel(&self, spacing: [f64; 2], resolution: u32) -> f64 {
+    pub(super) fn voxel(&self, spacing: [f64; 2], resolution: u32) -> f64 {
         match self.period {
             Some(l) => l / self.cell_voxels(spacing, resolution) as f64,
             None => spacing[0] / resolution as f64,
@@ -381,7 +391,7 @@ impl VoronoiJob {
     }
 
     /// Voxels across a member of `level`.
-    fn across(&self, level: f64, voxel: f64) -> f64 {
+    pub(super) fn across(&self, level: f64, voxel: f64) -> f64 {
         match self.structure {
             Structure::Net => 2.0 * level / voxel,
             Structure::Sheet => level / voxel,
@@ -390,7 +400,7 @@ impl VoronoiJob {
 
     /// Where the seeds came from (`poisson` or `file`), the generator's seed and the regularity,
     /// for the report.
-    fn seeding_report(&self) -> (&'static str, Option<u64>, f64) {
+    pub(super) fn seeding_report(&self) -> (&'static str, Option<u64>, f64) {
         match self.seeding {
             Seeding::Poisson {
                 seed, regularity, ..
@@ -399,14 +409,17 @@ impl VoronoiJob {
         }
     }
 
-    fn setting(&self) -> String {
+    pub(super) fn setting(&self) -> String {
+        if let Some(g) = &self.grading {
+            return format!("density field {}", g.field.source);
+        }
         match self.sizing {
             Sizing::Density(d) => format!("density {d}"),
             Sizing::Level(l) => format!("{} {l} mm", self.structure.level_name()),
         }
     }
 
-    fn name(&self) -> String {
+    pub(super) fn name(&self) -> String {
         format!(
             "the Voronoi {}",
             match self.structure {
@@ -416,7 +429,7 @@ impl VoronoiJob {
         )
     }
 
-    fn range(&self, family: &impl Members, voxel: f64) -> VoronoiRange {
+    pub(super) fn range(&self, family: &impl Members, voxel: f64) -> VoronoiRange {
         let min_level = self.min_level(voxel);
         VoronoiRange {
             min_level,
@@ -468,7 +481,7 @@ impl VoronoiJob {
 
     /// The resolution members of `level` need when the requested one leaves them thinner than
     /// [`MIN_STRUT_VOXELS`], and why; refused when even the finest searched would not do.
-    fn thin(&self, level: f64, spacing: [f64; 2]) -> Result<Option<(u32, String)>> {
+    pub(super) fn thin(&self, level: f64, spacing: [f64; 2]) -> Result<Option<(u32, String)>> {
         let req = self.resolution;
         let across = self.across(level, self.voxel(spacing, req));
         if across >= MIN_STRUT_VOXELS {
@@ -545,6 +558,9 @@ impl VoronoiJob {
     /// Runs the job, streaming the part's triangles into `sink`.
     pub fn run_into(&self, progress: &Progress, sink: &mut dyn MeshSink) -> Result<VoronoiReport> {
         let start = Instant::now();
+        if let Some(grading) = &self.grading {
+            return self.run_graded(grading, progress, sink);
+        }
         let (foam, spacing) = self.foam(progress)?;
         match self.net_cell(&foam)? {
             Some(family) => self.make(&family, &foam, spacing, start, progress, sink),
@@ -631,6 +647,8 @@ impl VoronoiJob {
             voxel_size: voxel,
             period: self.period,
             foam: foam.stats,
+            grading: None,
+            block: None,
             part,
             seeds: foam.own_seeds().to_vec(),
             cell: family.cell(),
@@ -704,29 +722,50 @@ impl VoronoiJob {
         Ok((model, report))
     }
 
-    /// The part as an implicit solid, for drawing and slicing from its settings: a periodic
-    /// net, as its strut lattice (the radius given, or the one its mesh is made to the density
-    /// at, in tiles beyond [`crate::render::MODEL_MEMORY`]; for slices moved so that it encloses
-    /// the mesh's volume). Other foams are drawn from their mesh.
+    /// The part as an implicit solid, for drawing and slicing from its settings: the strut
+    /// radius or wall thickness given, or the one its mesh is made to the density at (the same
+    /// search, on the same voxels; in tiles beyond [`crate::render::MODEL_MEMORY`]), for slices
+    /// moved so that it encloses the mesh's volume, with the fragments the mesh drops. A
+    /// periodic net is its strut lattice.
     pub fn model(&self, fidelity: crate::render::Fidelity) -> Result<crate::render::Model> {
         let (foam, spacing) = self.foam(&Progress::hidden())?;
-        let Some(family) = self.net_cell(&foam)? else {
-            return Err(Error::invalid(
-                "a Voronoi foam is drawn and sliced from its mesh unless it is a periodic net (--periodic): make it with -o part.stl, then render, view or slice part.stl",
-            ));
-        };
         let bounded = VoronoiJob {
             options: crate::render::model_options(&self.options),
             ..self.clone()
         };
-        let voxel0 = self.voxel(spacing, self.resolution);
-        let l0 = self.start_level(&family, voxel0)?;
-        let resolved = bounded.search(&family, l0, spacing, &Progress::hidden())?;
         let (given, target) = match self.sizing {
             Sizing::Level(r) => (Some(r), None),
             Sizing::Density(d) => (None, Some(d)),
         };
-        crate::render::Model::of_struts(&family, &resolved.found, given, target, fidelity)
+        let voxel0 = self.voxel(spacing, self.resolution);
+        if let Some(family) = self.net_cell(&foam)? {
+            let l0 = self.start_level(&family, voxel0)?;
+            let resolved = bounded.search(&family, l0, spacing, &Progress::hidden())?;
+            return crate::render::Model::of_struts(
+                &family,
+                &resolved.found,
+                given,
+                target,
+                fidelity,
+            );
+        }
+        let family = FoamFamily {
+            foam: Arc::new(foam),
+            bounds: self.bounds,
+        };
+        let l0 = self.start_level(&family, voxel0)?;
+        let resolved = bounded.search(&family, l0, spacing, &Progress::hidden())?;
+        // The level's integration on the part's own voxels (extrapolated, it is within 0.1 % on
+        // struts two voxels across): a foam is integrated whole, not a template cell.
+        crate::render::Model::of(
+            &family,
+            &resolved.found,
+            given,
+            target,
+            fidelity,
+            [spacing[0], resolved.found.voxel],
+            |f, level| crate::render::Lattice::Foam(f.at(level)),
+        )
     }
 
     /// Finds the resolution and level of the part: the level given, or the one at which the
@@ -767,7 +806,7 @@ impl VoronoiJob {
 
 /// What the job needs of a foam's family besides the pipeline's: the size at which its pores
 /// close, its beams, and, for a periodic net, its strut cell.
-trait Members: Family {
+pub(super) trait Members: Family {
     /// The largest level at which the pores stay open.
     fn closing(&self) -> f64;
     /// The net at `radius` as 3MF beams, the box clipping them.

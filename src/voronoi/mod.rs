@@ -2,6 +2,7 @@
 //! Voronoi diagram of Poisson-disk seeds (or the user's), at an exact density ([`job`]). The
 //! foam as a field and its seeds are [`crate::lattice::voronoi`].
 
+pub mod graded;
 pub mod job;
 
 pub use crate::lattice::voronoi::{seeds, FoamStats, Spread, Structure};

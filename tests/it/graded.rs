@@ -487,6 +487,55 @@ fn a_periodic_voronoi_net_graded_along_z_meets_the_grade_in_every_cell() {
     assert!(worst < 0.01, "{worst}");
 }
 
+/// Random Voronoi foams graded (`latvox voronoi --density-grade/--density-field`, no
+/// `--periodic`): a net along x and a sheet by an expression along z at an odd origin; every
+/// block of two spacings, cut out by manifold3d, meets the field at its centre.
+#[test]
+fn random_voronoi_foams_are_graded_block_by_block() {
+    let worst = check_cells(
+        &[
+            "voronoi",
+            "--spacing",
+            "2.5",
+            "--density-grade",
+            "x:0.1:0.25",
+            "--size",
+            "10",
+            "-r",
+            "12",
+        ],
+        [0.0; 3],
+        [5.0; 3],
+        [10.0; 3],
+        &|p| 0.1 + 0.15 * p[0] / 10.0,
+        &|_| true,
+    );
+    assert!(worst < 0.01, "net: {worst}");
+    let worst = check_cells(
+        &[
+            "voronoi",
+            "--structure",
+            "sheet",
+            "--spacing",
+            "2.5",
+            "--density-field",
+            "0.25 + 0.015*(z - 1)",
+            "--size",
+            "10,5,10",
+            "--origin",
+            "-3,2,1",
+            "-r",
+            "12",
+        ],
+        [-3.0, 2.0, 1.0],
+        [5.0; 3],
+        [10.0, 5.0, 10.0],
+        &|p| 0.25 + 0.015 * (p[2] - 1.0),
+        &|_| true,
+    );
+    assert!(worst < 0.01, "sheet: {worst}");
+}
+
 /// Strut cells graded at random (seeded): cell, axis, the grade's ends, a box that may end
 /// inside a cell, an origin, a resolution; and an octet truss graded by an expression, its
 /// joints blended.

@@ -20,8 +20,14 @@
 //!   implicit slices has a point inside a fragment (generalised winding number, computed here);
 //!   a part file that keeps its fragments does have such loops, so the check can fail.
 //!
+//!   Voronoi foams the same way (their own property: nets and sheets, random and periodic, with
+//!   pores or none), nets' layers at 32 voxels a spacing and finer; sheets are held to the
+//!   volume, as strut lattices are (their meshes fill the sharp creases where walls meet, and
+//!   round a pore's rim).
+//!
 //! Seeded: a failure names its case N, and `LATVOX_CASE=N` runs that case alone. The main tier
-//! runs 6 cases; the long tier (`cargo test --release -- --ignored implicit_slices`) 60.
+//! runs 6 cases (and 2 foams); the long tier (`cargo test --release -- --ignored
+//! implicit_slices`) 60 (and 12 foams).
 
 use crate::common::*;
 use crate::density_property::{round, FEASIBLE};
@@ -41,10 +47,12 @@ const CELLS: [(&str, f64, f64); 7] = [
 
 #[derive(Debug, Clone)]
 struct Case {
-    /// `tpms -t TYPE --structure S` or `strut --cell CELL`.
+    /// `tpms -t TYPE --structure S`, `strut --cell CELL` or `voronoi --spacing S …`.
     part: Vec<String>,
-    tpms: bool,
+    /// Whether each layer is checked (at `layers_from` voxels a cell or finer).
+    layers_from: Option<u64>,
     density: f64,
+    /// The cell size (a foam's spacing: it is not given as `--cell-size`).
     cell: f64,
     size: [f64; 3],
     origin: [f64; 3],
@@ -70,12 +78,56 @@ fn draw(rng: &mut Rng) -> Case {
     let cell = round(rng.uniform(3.0, 6.0), 2);
     Case {
         part,
-        tpms,
+        layers_from: tpms.then_some(40),
         density: round(density, 3),
         cell,
         size: [0; 3].map(|_| round(cell * rng.uniform(1.1, 2.8), 2)),
         origin: [0; 3].map(|_| round(rng.uniform(-5.0, 5.0), 2)),
         resolution: [12, 16, 24, 32, 40, 48][rng.below(6) as usize],
+    }
+}
+
+/// A Voronoi foam: a net or a sheet (one sheet in three with pores), random through its box or
+/// periodic (one in three), at a density within its range, in a box of a few spacings.
+fn draw_foam(rng: &mut Rng) -> Case {
+    let sheet = rng.below(2) == 0;
+    let spacing = round(rng.uniform(2.5, 3.5), 2);
+    let mut part: Vec<String> = ["voronoi", "--spacing"].map(String::from).to_vec();
+    part.push(spacing.to_string());
+    part.extend(["--seed".into(), (1 + rng.below(1000)).to_string()]);
+    let mut pores = false;
+    if sheet {
+        part.extend(["--structure", "sheet"].map(String::from));
+        if rng.below(3) == 0 {
+            pores = true;
+            part.extend([
+                "--pores".into(),
+                round(rng.uniform(0.3, 0.6), 2).to_string(),
+            ]);
+        }
+    }
+    if rng.below(3) == 0 {
+        part.extend([
+            "--periodic".into(),
+            round(spacing * rng.uniform(2.2, 3.0), 2).to_string(),
+        ]);
+    }
+    let density = if sheet {
+        rng.uniform(0.12, 0.35)
+    } else {
+        rng.uniform(0.08, 0.3)
+    };
+    let resolution = [16, 20, 24, 32][rng.below(4) as usize];
+    Case {
+        part,
+        // A sheet's mesh fills the sharp concave creases where its walls meet, and rounds a
+        // pore's rim: sheets are held to the volume, as strut lattices are.
+        layers_from: (!sheet && !pores).then_some(32),
+        density: round(density, 3),
+        cell: spacing,
+        size: [0; 3].map(|_| round(spacing * rng.uniform(2.2, 3.4), 2)),
+        origin: [0; 3].map(|_| round(rng.uniform(-5.0, 5.0), 2)),
+        resolution,
     }
 }
 
@@ -87,12 +139,13 @@ fn list(v: [f64; 3]) -> String {
 /// broken. Returns the implicit slices' volume against the mesh's, and the worst layer checked.
 fn check(n: usize, c: &Case, dir: &Path) -> Option<(f64, f64)> {
     let mut args: Vec<String> = c.part.clone();
+    if c.part[0] != "voronoi" {
+        args.extend(["--cell-size".into(), c.cell.to_string()]);
+    }
     args.extend(
         [
             "--density".into(),
             c.density.to_string(),
-            "--cell-size".into(),
-            c.cell.to_string(),
             "--size".into(),
             list(c.size),
             "--origin".into(),
@@ -161,7 +214,7 @@ fn check(n: usize, c: &Case, dir: &Path) -> Option<(f64, f64)> {
         "case {n} {c:?}: implicit slices hold {layer_volume} mm³, the mesh {mesh_volume} mm³"
     );
     let mut worst: f64 = 0.0;
-    if c.tpms && resolution >= 40 {
+    if c.layers_from.is_some_and(|r| resolution >= r) {
         ok(
             &["slice", "m.stl", "--layer", &layer, "--csv", "m.csv", "-q"],
             dir,
@@ -199,10 +252,14 @@ fn check(n: usize, c: &Case, dir: &Path) -> Option<(f64, f64)> {
 }
 
 fn property(cases: usize) {
+    property_of(cases, 0x005e_ed48, draw)
+}
+
+fn property_of(cases: usize, seed: u64, draw: fn(&mut Rng) -> Case) {
     let only: Option<usize> = std::env::var("LATVOX_CASE")
         .ok()
         .map(|s| s.parse().unwrap());
-    let mut rng = Rng(0x005e_ed48);
+    let mut rng = Rng(seed);
     let (mut done, mut refused) = (0, 0);
     let (mut volume_worst, mut layer_worst): (f64, f64) = (0.0, 0.0);
     for n in 0..cases {
@@ -237,6 +294,18 @@ fn implicit_slices_hold_the_mesh_at_random_settings() {
 #[ignore = "long: sixty random parts sliced both ways"]
 fn implicit_slices_hold_the_mesh_at_sixty_random_settings() {
     property(60);
+}
+
+/// Voronoi foams, nets and sheets, random and periodic, with and without pores.
+#[test]
+fn implicit_slices_of_voronoi_foams_hold_the_mesh() {
+    property_of(2, 0x0f0a_3546, draw_foam);
+}
+
+#[test]
+#[ignore = "long: twelve random Voronoi foams sliced both ways"]
+fn implicit_slices_of_voronoi_foams_hold_the_mesh_at_twelve_settings() {
+    property_of(12, 0x0f0a_3546, draw_foam);
 }
 
 /// Each layer's loops from an ASCII CLI file: the layer's top height and its loops.

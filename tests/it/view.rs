@@ -187,8 +187,9 @@ fn drive(url: &str, out: &Path, args: &[&str]) -> Option<serde_json::Value> {
 /// same camera: silhouettes agree on ≥ 98 % of pixels, and where both see the part, the colours
 /// (the same shading from the same normals) agree within 24 levels on ≥ 95 % of the pixels.
 /// Changing a control re-renders, and the part file the page saves renders (CPU) as the page drew
-/// it. A TPMS part in a box of odd origin, a strut part, and a part filled with a lattice under
-/// a skin, cut open by a section so that the lattice, skin and cut faces are what is compared.
+/// it. A TPMS part in a box of odd origin, a strut part, a part filled with a lattice under
+/// a skin, cut open by a section so that the lattice, skin and cut faces are what is compared,
+/// and Voronoi foams: a random net turned into a sheet, and a sheet with pores cut open.
 #[test]
 #[ignore = "long: headless Chromium draws, edits and saves the part"]
 fn the_page_draws_the_part_as_render_does() {
@@ -197,7 +198,7 @@ fn the_page_draws_the_part_as_render_does() {
         &d.path().join("cube.stl"),
         &meshkit::cuboid([-2.0, 0.0, 1.0], [18.0, 14.0, 13.0]),
     );
-    let cases: [(&[&str], Option<&str>, &str, &str); 3] = [
+    let cases: [(&[&str], Option<&str>, &str, &str); 5] = [
         (
             &[
                 "tpms",
@@ -246,6 +247,46 @@ fn the_page_draws_the_part_as_render_does() {
             Some("z=8"),
             "lattice=gyroid",
             "lattice = \"gyroid\"",
+        ),
+        (
+            &[
+                "voronoi",
+                "--spacing",
+                "3",
+                "--density",
+                "0.15",
+                "--size",
+                "9,8,7",
+                "--origin",
+                "-1,2,0",
+                "-r",
+                "16",
+            ],
+            None,
+            "structure=sheet",
+            "structure = \"sheet\"",
+        ),
+        (
+            &[
+                "voronoi",
+                "--structure",
+                "sheet",
+                "--pores",
+                "0.5",
+                "--spacing",
+                "3",
+                "--density",
+                "0.2",
+                "--size",
+                "9,9,7",
+                "--origin",
+                "1,-2,0.5",
+                "-r",
+                "12",
+            ],
+            Some("y=2"),
+            "pores=0.8",
+            "pores = 0.8",
         ),
     ];
     let (w, h) = (240u32, 180u32);

@@ -496,7 +496,8 @@ fn bad_settings_are_refused() {
             "--spacing-field",
         ),
         (&["--cell-out", "c.json"], "--periodic"),
-        (&["--density-grade", "z:0.1:0.3"], "periodic net"),
+        (&["--density-grade", "z:0.1:0.3", "--beams"], "as a mesh"),
+        (&["--stiffness-field", "0.02"], "repeating cell"),
         (
             &[
                 "--periodic",
@@ -506,7 +507,7 @@ fn bad_settings_are_refused() {
                 "--density-field",
                 "0.2",
             ],
-            "periodic net",
+            "periodic sheet",
         ),
         (
             &[

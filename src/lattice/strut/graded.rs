@@ -10,7 +10,7 @@ use crate::error::Result;
 use crate::field::{numeric_gradient, Aabb, Field, Vec3};
 use crate::grid::GridSpec;
 use crate::mesh::graded::{self, LevelGrid, LevelMap, Levelled};
-use crate::mesh::pipeline::{self, Family, Options, Route, Solid};
+use crate::mesh::pipeline::{Options, Solid};
 
 struct GradedStrutField<'a> {
     struts: StrutField,
@@ -122,25 +122,6 @@ pub fn calibrate(
         }),
         model: family.model.clone(),
     };
-    let opts = Options {
-        verify: crate::verify::Verify::None,
-        instancing: false,
-        keep_fragments: true,
-        ..*opts
-    };
-    let knots = graded::knots(lo, hi);
-    let mut bias = Vec::with_capacity(knots.len());
-    let mut met = true;
-    for &rho in &knots {
-        let r0 = one.model.radius(rho);
-        let route = Route::choose(&one.at(r0), voxel, &opts);
-        let solved = pipeline::solve(&one, rho, r0, voxel, route, &opts)?;
-        met &= solved.met;
-        bias.push(one.model.fraction(solved.best.level) - rho);
-    }
     let model = family.model.clone();
-    Ok((
-        LevelMap::new(lo, hi, &knots, &bias, |f| model.radius(f)),
-        met,
-    ))
+    graded::calibrate_on(&one, voxel, opts, lo, hi, |f| model.radius(f))
 }

@@ -30,6 +30,7 @@ use crate::grid::GridSpec;
 use crate::io::threemf::BeamModel;
 use crate::lattice::model::LevelModel;
 use crate::lattice::strut::beams::segment_box_distance;
+use crate::mesh::graded::LevelGrid;
 use crate::mesh::pipeline::{Family, Solid};
 use kiddo::{KdTree, SquaredEuclidean};
 use std::collections::HashMap;
@@ -324,6 +325,30 @@ impl Foam {
         self.pores.values()
     }
 
+    /// The pores through the walls, each with the indices of the two seeds (lower first)
+    /// whose wall it opens.
+    pub fn pore_pairs(&self) -> impl Iterator<Item = ((u32, u32), &Pore)> {
+        self.pores.iter().map(|(k, p)| (*k, p))
+    }
+
+    /// The seed nearest `p`: its index and distance.
+    pub fn nearest_seed(&self, p: Vec3) -> (u32, f64) {
+        let n = self.tree.nearest_one::<SquaredEuclidean>(&p);
+        (n.item as u32, n.distance.sqrt())
+    }
+
+    /// The indices of the seeds within `r` of `p`, in increasing order.
+    pub fn seeds_within(&self, p: Vec3, r: f64) -> Vec<u32> {
+        let mut found: Vec<u32> = self
+            .tree
+            .within_unsorted::<SquaredEuclidean>(&p, r * r)
+            .iter()
+            .map(|n| n.item as u32)
+            .collect();
+        found.sort_unstable();
+        found
+    }
+
     /// The seeds that make the foam: all of them, or a periodic foam's cell's own.
     pub fn own_seeds(&self) -> &[Vec3] {
         let s = &self.diagram.seeds;
@@ -428,8 +453,14 @@ impl Foam {
     }
 
     fn measure_model(&self) -> LevelModel {
+        self.model_in(&self.bounds)
+    }
+
+    /// The volume fraction against the level of the foam in `region` (a part of its box), as
+    /// [`Foam::model`] measures the box's.
+    pub fn model_in(&self, region: &Aabb) -> LevelModel {
         use rayon::prelude::*;
-        let size = self.bounds.size();
+        let size = region.size();
         let far = self.reach;
         let skeleton = match self.structure {
             Structure::Net => self.net_field(0.0, far),
@@ -437,7 +468,7 @@ impl Foam {
         };
         let mut rng = Rng::new(0x5eed);
         let points: Vec<Vec3> = (0..MODEL_POINTS)
-            .map(|_| [0, 1, 2].map(|k| self.bounds.min[k] + rng.unit() * size[k]))
+            .map(|_| [0, 1, 2].map(|k| region.min[k] + rng.unit() * size[k]))
             .collect();
         let levels: Vec<f64> = points
             .par_iter()
@@ -517,11 +548,45 @@ pub struct FoamSolid {
     pub bounds: Aabb,
 }
 
-/// The walls' field: distance to the nearest face minus half the thickness, clamped at `reach`.
-struct SheetField<'a> {
-    foam: &'a Foam,
-    half: f64,
-    reach: f64,
+/// Half a wall's thickness at a point: the same everywhere, or half the level a grid gives
+/// there (a graded sheet).
+#[derive(Clone, Copy)]
+pub(super) enum Half<'a> {
+    /// The same everywhere, mm.
+    Uniform(f64),
+    /// Half the grid's level plus `offset`.
+    Graded {
+        /// The level at each point.
+        levels: &'a LevelGrid,
+        /// Added to it.
+        offset: f64,
+    },
+}
+
+impl Half<'_> {
+    fn at(&self, p: Vec3) -> f64 {
+        match *self {
+            Half::Uniform(h) => h,
+            Half::Graded { levels, offset } => 0.5 * (levels.at(p).0 + offset).max(0.0),
+        }
+    }
+
+    /// The most it is anywhere.
+    fn most(&self) -> f64 {
+        match *self {
+            Half::Uniform(h) => h,
+            Half::Graded { levels, offset } => 0.5 * (levels.max + offset).max(0.0),
+        }
+    }
+}
+
+/// The walls' field: distance to the nearest face minus half the thickness, clamped at `reach`;
+/// `lipschitz` bounds its slope (1, or more where the thickness varies), for its clearance.
+pub(super) struct SheetField<'a> {
+    pub(super) foam: &'a Foam,
+    pub(super) half: Half<'a>,
+    pub(super) reach: f64,
+    pub(super) lipschitz: f64,
 }
 
 impl SheetField<'_> {
@@ -530,7 +595,7 @@ impl SheetField<'_> {
     fn values_near(&self, centre: Vec3, spread: f64, points: &[Vec3], out: &mut [f64]) {
         let tree = &self.foam.tree;
         let seeds = &self.foam.diagram.seeds;
-        let cap = self.half + self.reach;
+        let cap = self.half.most() + self.reach;
         let a = tree
             .nearest_one::<SquaredEuclidean>(&centre)
             .distance
@@ -560,13 +625,12 @@ impl SheetField<'_> {
                     }
                 }
             }
-            let wall = d - self.half;
+            let half = self.half.at(*p);
+            let wall = d - half;
             // A pore cuts the wall through, and the narrow band beyond it.
             let hole = other
                 .and_then(|j| self.foam.pore(index[i1], index[j]))
-                .map_or(f64::NEG_INFINITY, |pore| {
-                    pore.inside(*p, self.half + self.reach)
-                });
+                .map_or(f64::NEG_INFINITY, |pore| pore.inside(*p, half + self.reach));
             *o = wall.max(hole).min(self.reach);
         }
     }
@@ -580,13 +644,14 @@ impl Field for SheetField<'_> {
     }
 
     fn clearance(&self, p: Vec3) -> f64 {
-        self.value(p).abs()
+        self.value(p).abs() / self.lipschitz
     }
 
     /// Not where a pore cuts its wall: its rim is a crease that snapping would fold.
     fn smooth_near(&self, p: Vec3, reach: f64) -> bool {
-        match self.foam.face_distance(p, self.half + self.reach) {
-            (_, Some(pore)) => pore.inside(p, self.half + reach) < -reach,
+        let half = self.half.most();
+        match self.foam.face_distance(p, half + self.reach) {
+            (_, Some(pore)) => pore.inside(p, half + reach) < -reach,
             _ => true,
         }
     }
@@ -679,8 +744,9 @@ impl FoamSolid {
             Structure::Net => Box::new(self.foam.net_field(self.level, reach)),
             Structure::Sheet => Box::new(SheetField {
                 foam: &self.foam,
-                half: 0.5 * self.level,
+                half: Half::Uniform(0.5 * self.level),
                 reach,
+                lipschitz: 1.0,
             }),
         }
     }

@@ -5,7 +5,8 @@
 
 pub mod diagram;
 pub mod foam;
+pub mod graded;
 pub mod periodic;
 pub mod seeds;
 
-pub use foam::{Foam, FoamFamily, FoamSolid, FoamStats, Spread, Structure};
+pub use foam::{Foam, FoamFamily, FoamSolid, FoamStats, Pore, Spread, Structure};

@@ -2,10 +2,11 @@
 //! trilinearly, and the lattice at that level for the pipeline.
 
 use super::{MAP_MARGIN, NODES_PER_CELL};
+use crate::error::Result;
 use crate::field::nodes::Nodes;
 use crate::field::{Aabb, Field, Vec3};
 use crate::grid::GridSpec;
-use crate::mesh::pipeline::{Family, Solid};
+use crate::mesh::pipeline::{self, Family, Options, Route, Solid};
 
 /// Knots at which a type is calibrated over `[lo, hi]`: six across it, one when it is a point.
 pub fn knots(lo: f64, hi: f64) -> Vec<f64> {
@@ -13,6 +14,38 @@ pub fn knots(lo: f64, hi: f64) -> Vec<f64> {
         return vec![lo];
     }
     (0..6).map(|i| lo + (hi - lo) * i as f64 / 5.0).collect()
+}
+
+/// A type's density → level map over `[lo, hi]` at `voxel`, calibrated on `sample` (its unit
+/// cell, or a block of the part, whose model is its own): at each knot the level at which
+/// `sample`'s mesh meets the density, found by the pipeline's search, its bias against
+/// `sample`'s model interpolated between the knots and read off `model_level` (the type's, the
+/// whole part's, fraction → level); whether every search met its density.
+pub fn calibrate_on<F: Family>(
+    sample: &F,
+    voxel: f64,
+    opts: &Options,
+    lo: f64,
+    hi: f64,
+    model_level: impl Fn(f64) -> f64,
+) -> Result<(LevelMap, bool)> {
+    let opts = Options {
+        verify: crate::verify::Verify::None,
+        instancing: false,
+        keep_fragments: true,
+        ..*opts
+    };
+    let knots = knots(lo, hi);
+    let mut bias = Vec::with_capacity(knots.len());
+    let mut met = true;
+    for &rho in &knots {
+        let l0 = sample.model_level(rho);
+        let route = Route::choose(&sample.at(l0), voxel, &opts);
+        let solved = pipeline::solve(sample, rho, l0, voxel, route, &opts)?;
+        met &= solved.met;
+        bias.push(sample.model_fraction(solved.best.level) - rho);
+    }
+    Ok((LevelMap::new(lo, hi, &knots, &bias, model_level), met))
 }
 
 /// A type's calibrated density → level map at one voxel size, tabulated over a range.

@@ -36,7 +36,9 @@ pub mod correct;
 pub mod levels;
 
 pub use correct::{mesh, Cells, Outcome};
-pub use levels::{knots, Graded, GradedFamily, GradedPart, LevelGrid, LevelMap, Levelled, Mapped};
+pub use levels::{
+    calibrate_on, knots, Graded, GradedFamily, GradedPart, LevelGrid, LevelMap, Levelled, Mapped,
+};
 
 /// A promised cell's measured density must be within this of the field at its centre.
 pub const CELL_PROMISE: f64 = 0.01;

@@ -43,7 +43,7 @@ const POLICY: &str = "default-src 'self'; script-src 'self' 'unsafe-eval'; \
                       base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
 
 /// The commands whose parts the editor meshes (the command a child `latvox` runs).
-const COMMANDS: &[&str] = &["tpms", "strut", "fill"];
+const COMMANDS: &[&str] = &["tpms", "strut", "voronoi", "fill"];
 
 /// What the page draws of a part's settings, with every refusal of the part's command.
 pub type SceneOf = Box<dyn Fn(&toml::Table) -> Result<Scene> + Send + Sync>;

@@ -9,7 +9,10 @@
 // bound on |∇F|. Struts: a point maps into one cell (q = (p − phase) mod size − size/2) and the
 // distance is the least over the augmented cell's struts (the cell's own and every copy that
 // reaches it), capped at the reach: a strut outside the list is farther than the reach, so the
-// capped distance is a safe step across cells. Filled parts: a ray is cast at the part's
+// capped distance is a safe step across cells (a random Voronoi net is one cell covering its
+// box). Voronoi walls: a point's distance to its cell's boundary is the least over the other
+// seeds of its distance to their bisector plane with the nearest, less half the thickness, the
+// pore through a wall cut out of it. Filled parts: a ray is cast at the part's
 // surface through its BVH, and only inside it is the lattice sphere-traced, joined to a skin by
 // the depth below the surface (the BVH's distance, capped), less the drain holes; kept solids
 // are cast at as meshes.
@@ -25,8 +28,8 @@ uniform vec3 uUp;
 uniform float uTanHalf;
 uniform vec3 uBoxMin;
 uniform vec3 uBoxMax;
-uniform int uKind;          // 0 TPMS, 1 struts
-uniform float uLevel;       // TPMS level, or strut radius (mm)
+uniform int uKind;          // 0 TPMS, 1 struts, 2 Voronoi walls
+uniform float uLevel;       // TPMS level, strut radius or wall thickness (mm)
 uniform vec3 uCell;         // cell size, mm
 uniform vec3 uPhase;        // a cell's lower corner, mm
 // TPMS
@@ -37,7 +40,16 @@ uniform float uLipschitz;
 // Struts, listed per bin of the cell: two texels per strut, (a, factor) and (b, factor), 1024
 // texels a row.
 uniform sampler2D uStruts;
-uniform int uBinStart[65];  // per bin of the cell (4 per axis), where its struts start; then the end
+// Struts and walls: per bin of the cell (uBins per axis), where its list starts; then the end.
+uniform sampler2D uBinTex;
+uniform ivec3 uBins;
+// Walls, listed per bin: a seed is one texel (its place from the phase, its index); a pore three
+// (centre, radius), (normal, 0), (the two seeds' indices, 0, 0), with its bins' starts in
+// uPoreBins.
+uniform sampler2D uSeeds;
+uniform sampler2D uPores;
+uniform sampler2D uPoreBins;
+uniform int uRepeat;        // walls: 1 where the cell repeats (a periodic foam)
 uniform float uBlend;
 uniform float uReach;
 // Section: keep where dot(n, p) <= d.
@@ -138,14 +150,23 @@ float smoothMin(float a, float b, float k) {
     return min(a, b) - 0.25 * h * h * k;
 }
 
+// The bin of a point `r` of the cell (from its lower corner).
+int binOf(vec3 r) {
+    ivec3 c = clamp(ivec3(r / uCell * vec3(uBins)), ivec3(0), uBins - 1);
+    return (c.x * uBins.y + c.y) * uBins.z + c.z;
+}
+
+int binStart(sampler2D s, int bin) {
+    return int(fetch(s, bin).x);
+}
+
 vec2 struts(vec3 p) {
     vec3 r = mod(p - uPhase, uCell);
-    ivec3 c = clamp(ivec3(r / uCell * 4.0), 0, 3);
-    int bin = (c.x * 4 + c.y) * 4 + c.z;
+    int bin = binOf(r);
     vec3 q = r - 0.5 * uCell;
     float d = uReach;
-    int end = uBinStart[bin + 1];
-    for (int i = uBinStart[bin]; i < end; i++) {
+    int end = binStart(uBinTex, bin + 1);
+    for (int i = binStart(uBinTex, bin); i < end; i++) {
         vec4 a = strutTexel(2 * i);
         vec4 b = strutTexel(2 * i + 1);
         float di = strutDistance(q, a.xyz, b.xyz, uLevel * a.w, uLevel * b.w);
@@ -153,6 +174,57 @@ vec2 struts(vec3 p) {
     }
     d = min(d, uReach);
     return vec2(d, abs(d));
+}
+
+vec2 walls(vec3 p) {
+    vec3 r = uRepeat == 1 ? mod(p - uPhase, uCell) : p - uPhase;
+    int bin = binOf(r);
+    int start = binStart(uBinTex, bin);
+    int end = binStart(uBinTex, bin + 1);
+    float best = 1e30;
+    vec4 s1 = vec4(0.0, 0.0, 0.0, -1.0);
+    for (int i = start; i < end; i++) {
+        vec4 s = fetch(uSeeds, i);
+        vec3 e = r - s.xyz;
+        float d2 = dot(e, e);
+        if (d2 < best) {
+            best = d2;
+            s1 = s;
+        }
+    }
+    float halfT = 0.5 * uLevel;
+    float d = halfT + uReach;
+    float other = -1.0;
+    for (int i = start; i < end; i++) {
+        vec4 s = fetch(uSeeds, i);
+        if (s.w == s1.w) continue;
+        float c = length(s.xyz - s1.xyz);
+        vec3 e = r - s.xyz;
+        float v = (dot(e, e) - best) / (2.0 * c);
+        if (c > 0.0 && v < d) {
+            d = v;
+            other = s.w;
+        }
+    }
+    float v = d - halfT;
+    if (other >= 0.0) {
+        float lo = min(s1.w, other);
+        float hi = max(s1.w, other);
+        int pe = binStart(uPoreBins, bin + 1);
+        for (int k = binStart(uPoreBins, bin); k < pe; k++) {
+            vec4 ids = fetch(uPores, 3 * k + 2);
+            if (ids.x != lo || ids.y != hi) continue;
+            vec4 c = fetch(uPores, 3 * k);
+            vec3 n = fetch(uPores, 3 * k + 1).xyz;
+            vec3 w = r - c.xyz;
+            float along = dot(w, n);
+            float across = sqrt(max(dot(w, w) - along * along, 0.0));
+            v = max(v, min(c.w - across, halfT + uReach - abs(along)));
+            break;
+        }
+    }
+    v = min(v, uReach);
+    return vec2(v, abs(v));
 }
 
 float boxValue(vec3 p) {
@@ -165,6 +237,7 @@ float boxValue(vec3 p) {
 vec2 latticeVC(vec3 p) {
     // Branches, not a conditional expression: a shader compiler may evaluate both of those.
     if (uKind == 0) return tpms(p);
+    if (uKind == 2) return walls(p);
     return struts(p);
 }
 

@@ -89,7 +89,8 @@ async function setupGl() {
   const buffer = gl.createBuffer();
   gl.bindBuffer(gl.ARRAY_BUFFER, buffer);
   gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-1, -1, 1, -1, -1, 1, 1, 1]), gl.STATIC_DRAW);
-  ['uStruts', 'uPartNodes', 'uPartTris', 'uKeepNodes', 'uKeepTris'].forEach((name, unit) => {
+  ['uStruts', 'uPartNodes', 'uPartTris', 'uKeepNodes', 'uKeepTris', 'uBinTex', 'uSeeds', 'uPores',
+    'uPoreBins'].forEach((name, unit) => {
     textures[name] = { texture: gl.createTexture(), unit };
   });
 }
@@ -192,12 +193,24 @@ function loadScene(scene) {
     set('uReach', '1f', scene.reach);
     set('uCell', '3fv', t.size);
     set('uPhase', '3fv', t.phase);
+  } else if (scene.kind === 'walls') {
+    const w = scene.walls;
+    upload('uSeeds', w.seeds, 1);
+    upload('uBinTex', w.bins.map((b) => [b, 0, 0, 0]), 1);
+    upload('uPores', w.pores, 3);
+    upload('uPoreBins', w.pore_bins.map((b) => [b, 0, 0, 0]), 1);
+    set('uKind', '1i', 2);
+    set('uBins', '3i', ...w.bins_per_axis);
+    set('uRepeat', '1i', w.periodic ? 1 : 0);
+    set('uReach', '1f', scene.reach);
+    set('uCell', '3fv', w.size);
+    set('uPhase', '3fv', w.phase);
   } else {
     const s = scene.struts;
     upload('uStruts', s.struts, 2);
+    upload('uBinTex', s.bins.map((b) => [b, 0, 0, 0]), 1);
     set('uKind', '1i', 1);
-    if (s.bins_per_axis !== 4) throw new Error('the shader takes 4 bins per axis');
-    set('uBinStart', '1iv', new Int32Array(s.bins));
+    set('uBins', '3i', ...s.bins_per_axis);
     set('uBlend', '1f', s.blend);
     set('uReach', '1f', scene.reach);
     set('uCell', '3fv', s.size);
@@ -430,8 +443,10 @@ function buildSettings() {
         ? input.value : valueOf(input.value);
       if (v === undefined) delete state.settings[key]; else state.settings[key] = v;
       // Density and radius exclude each other: the one edited wins.
-      if (key === 'density' && v !== undefined) { delete state.settings.radius; $('set-radius') && ($('set-radius').value = ''); }
-      if (key === 'radius' && v !== undefined) { delete state.settings.density; $('set-density') && ($('set-density').value = ''); }
+      if (key === 'density' && v !== undefined) {
+        for (const k of ['radius', 'thickness']) { delete state.settings[k]; $('set-' + k) && ($('set-' + k).value = ''); }
+      }
+      if ((key === 'radius' || key === 'thickness') && v !== undefined) { delete state.settings.density; $('set-density') && ($('set-density').value = ''); }
       rescene();
     });
     row.appendChild(input);
@@ -439,19 +454,29 @@ function buildSettings() {
   }
 }
 
-// Whether the radius control edits the part's own radius (a strut part's), not a preview.
-function radiusIsSetting() {
-  return state.scene.kind === 'struts' && state.settings.command === 'strut';
+// The part's setting the level control edits (a strut or Voronoi net's radius, a Voronoi
+// sheet's thickness), or null where it previews another level than the density's.
+function levelSetting() {
+  const c = state.settings.command;
+  if (state.scene.kind === 'struts' && (c === 'strut' || c === 'voronoi')) return 'radius';
+  if (state.scene.kind === 'walls' && c === 'voronoi') return 'thickness';
+  return null;
+}
+
+// The largest radius or thickness the scene's lists hold every strut or seed for.
+function levelMax() {
+  return state.scene.kind === 'walls' ? state.scene.walls.max_thickness : state.scene.struts.max_radius;
 }
 
 function showLevel() {
-  const struts = state.scene.kind === 'struts';
-  $('levelName').textContent = struts ? 'radius (mm)' : 'level';
+  const sized = state.scene.kind !== 'tpms';
+  const name = state.scene.kind === 'walls' ? 'thickness' : 'radius';
+  $('levelName').textContent = sized ? `${name} (mm)` : 'level';
   $('level').value = state.level.toPrecision(4);
-  $('level').step = struts ? (state.level / 20).toPrecision(2) : '0.01';
-  $('levelNote').textContent = radiusIsSetting()
-    ? 'The radius draws at once and is saved as the part\'s radius.'
-    : `The ${struts ? 'radius' : 'level'} the density gives; another is a preview (the density sets the saved part).`;
+  $('level').step = sized ? (state.level / 20).toPrecision(2) : '0.01';
+  $('levelNote').textContent = levelSetting()
+    ? `The ${name} draws at once and is saved as the part's ${name}.`
+    : `The ${sized ? name : 'level'} the density gives; another is a preview (the density sets the saved part).`;
 }
 
 function sectionRange() {
@@ -478,20 +503,22 @@ function wire() {
   $('level').addEventListener('input', () => {
     const v = Number($('level').value);
     if (!isFinite(v)) return;
-    if (state.scene.kind === 'struts' && !(v > 0)) return;
-    if (state.scene.kind === 'struts' && !radiusIsSetting()) {
-      // A preview within the radius the strut list holds every strut for.
-      state.level = Math.min(v, state.scene.struts.max_radius);
+    const sized = state.scene.kind !== 'tpms';
+    if (sized && !(v > 0)) return;
+    const key = levelSetting();
+    if (sized && !key) {
+      // A preview within the size the lists hold every strut or seed for.
+      state.level = Math.min(v, levelMax());
       requestDraw();
       return;
     }
-    if (radiusIsSetting()) {
-      state.settings.radius = Number(v.toPrecision(6));
+    if (key) {
+      state.settings[key] = Number(v.toPrecision(6));
       delete state.settings.density;
-      if ($('set-radius')) $('set-radius').value = state.settings.radius;
+      if ($('set-' + key)) $('set-' + key).value = state.settings[key];
       if ($('set-density')) $('set-density').value = '';
-      // Past the radius the strut list was built for, the server builds a longer one.
-      if (v > state.scene.struts.max_radius) { rescene(); return; }
+      // Past the size the lists were built for, the server builds longer ones.
+      if (v > levelMax()) { rescene(); return; }
     }
     state.level = v;
     requestDraw();
