@@ -788,6 +788,7 @@ def repair(
     drop_open_shells: bool = False,
     remesh: Optional[Value] = None,
     solid: bool = False,
+    tolerance: Optional[Value] = None,
     strict: bool = False,
     progress: Progress = None,
     threads: Optional[int] = None,
@@ -811,6 +812,9 @@ def repair(
     drop_open_shells: Drop shells that are still open after repair (they are reported either way)
     remesh: Rebuild the part through an OpenVDB level set with this voxel size (mm), or `auto`
     solid: End in one valid closed solid: drop open shells, join overlapping or crossing ones
+    tolerance: Simplify what a remesh makes (--remesh, or --solid where it remeshes) within this
+        distance of the input's surface, mm: fewer triangles where the part is flat, the same valid
+        solid
     """
     ...
 

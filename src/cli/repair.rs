@@ -18,6 +18,7 @@ Examples:
   latvox repair assembly.3mf -o print.stl --solid
   latvox repair broken.ply -o solid.stl --remesh auto
   latvox repair broken.ply -o solid.stl --remesh 0.2
+  latvox repair plate.stl -o plate-solid.stl --solid --tolerance 0.05
   latvox repair assembly.stl -o part.stl --drop-open-shells
   latvox repair implant-lattice.3mf -o implant.stl --beam-voxel 0.02
 
@@ -30,10 +31,17 @@ A valid mesh comes back unchanged. Shells that stay open are reported, and only 
 
 --solid: when the file must print as one solid (assemblies of overlapping parts, exports with
 stray facets, shells crossing each other or themselves). After the repair above, shells that
-are still open have no inside and are dropped (counted); shells that overlap or cross are
-joined: by CGAL's corefinement (an exact union) when each is a clean closed shell, otherwise
-their group alone is remeshed through OpenVDB; if anything is still wrong, the whole part is
-remeshed. The result is one valid closed solid, or the reason none exists.
+are still open and enclose nothing are strays, dropped (counted); shells that overlap
+or cross are joined: by CGAL's corefinement (an exact union) when each is a clean closed shell,
+otherwise their group alone is remeshed through OpenVDB; if anything is still wrong, the whole
+part is remeshed. Where the open shells enclose something together (a soup of open,
+overlapping, non-manifold pieces, with no closed shell of their own), the whole is made solid by its generalised winding number
+(Barill et al., \"Fast winding numbers for soups and clouds\", 2018): inside where it exceeds ½,
+a hole spanned like a soap film. The result is one valid closed solid, or the reason none
+exists.
+
+--tolerance MM simplifies what a remesh made, within MM of the input's surface: triangles merged
+where it is flat, each step checked against the input's distance field, the volume kept.
 
 --remesh VOXEL|auto rebuilds the part through an OpenVDB level set: closed, manifold and free
 of self-intersections at that resolution (details below a voxel are lost). auto: a quarter of
@@ -104,6 +112,11 @@ pub struct RepairArgs {
     /// End in one valid closed solid: drop open shells, join overlapping or crossing ones.
     #[arg(long)]
     pub solid: bool,
+    /// Simplify what a remesh makes (--remesh, or --solid where it remeshes) within this
+    /// distance of the input's surface, mm: fewer triangles where the part is flat, the same
+    /// valid solid.
+    #[arg(long, value_name = "MM", value_parser = super::parse_positive)]
+    pub tolerance: Option<f64>,
 }
 
 fn parse_remesh(s: &str) -> std::result::Result<Remesh, String> {
@@ -124,6 +137,7 @@ impl RepairArgs {
             drop_open_shells: self.drop_open_shells,
             remesh: self.remesh,
             solid: self.solid,
+            tolerance: self.tolerance,
         }
     }
 }
@@ -178,10 +192,11 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
                 s.facets,
                 s.boundary_edges,
                 s.hole_loops,
-                if s.dropped {
-                    ", dropped as asked"
-                } else {
-                    " — kept; --drop-open-shells removes it"
+                match (s.dropped, a.solid) {
+                    (true, true) => ", dropped (a stray beside the closed shells)",
+                    (true, false) => ", dropped as asked",
+                    (false, true) => ", made solid with the rest by the winding number",
+                    (false, false) => " — kept; --drop-open-shells removes it",
                 }
             );
         }
@@ -198,6 +213,20 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
         }
         if let Some(v) = changes.remesh_voxel {
             outln!("voxel     {v:.4} mm (remesh)");
+        }
+        if let Some(sm) = &changes.simplified {
+            let st = &sm.stats;
+            outln!(
+                "simplified {} of the remesh's {} triangles ({:.1}× fewer); deviation {:.4} mm from the input's surface measured, tolerance {} mm (the remesh's own {:.4} mm)",
+                st.triangles_after,
+                st.triangles_before,
+                st.triangles_before as f64 / st.triangles_after.max(1) as f64,
+                sm.deviation,
+                st.tolerance,
+                sm.uniform_deviation
+            );
+        } else if a.tolerance.is_some() {
+            outln!("simplified nothing: no remesh was made (the facets are the input's own)");
         }
         if let Some(d) = &r.deviation {
             outln!(

@@ -396,9 +396,9 @@ fn orient_pieces(points: &[Vec3], area: &[f64], normals: &mut [Vec3], piece: &[u
         4.0 * std::f64::consts::PI
     };
     let dipole = if planar {
-        super::winding::dipole_2d
+        crate::geom::winding::dipole_2d
     } else {
-        super::winding::dipole
+        crate::geom::winding::dipole
     };
     // The nesting depth of each piece: the winding number of the others at one of its points.
     let depth: Vec<(usize, i64)> = largest

@@ -10,7 +10,7 @@
 //! say nothing trustworthy, and the sign comes from an inside test that looks at the whole
 //! cloud:
 //! - `Winding` (default): the generalised winding number `w` of the oriented points
-//!   ([`super::winding`]); the value is `(½ − w)·4u` held within `±u`, `u` the distance to the
+//!   ([`crate::geom::winding`]); the value is `(½ − w)·4u` held within `±u`, `u` the distance to the
 //!   nearest point — `±u` where the winding number is clearly in or out, zero where `w = ½`,
 //!   which spans a hole in the scan like a soap film, so a missing patch closes instead of
 //!   letting the outside in;
@@ -30,8 +30,8 @@
 //! inside its sign.
 
 use super::cloud::Cloud;
-use super::winding::Winding;
 use crate::field::{Field, Vec3};
+use crate::geom::winding::Winding;
 use crate::grid::GridSpec;
 use rayon::prelude::*;
 use std::collections::HashSet;
@@ -78,7 +78,8 @@ impl<'a> ScanSdf<'a> {
             lo[2] = 0;
             n[2] = 1;
         }
-        let winding = (method == Sign::Winding).then(|| Winding::new(cloud));
+        let winding = (method == Sign::Winding)
+            .then(|| Winding::of_points(&cloud.points, &cloud.normals, &cloud.area, cloud.planar));
         let mut sdf = ScanSdf {
             cloud,
             winding,
@@ -106,20 +107,11 @@ impl<'a> ScanSdf<'a> {
 
     /// The block at position `i` of the lattice (x slowest, z fastest).
     fn block_at(&self, i: usize) -> [i64; 3] {
-        let (i, [_, ny, nz]) = (i as i64, self.n);
-        [
-            self.lo[0] + i / (ny * nz),
-            self.lo[1] + (i / nz) % ny,
-            self.lo[2] + i % nz,
-        ]
+        crate::geom::block_at(self.lo, self.n, i)
     }
 
     fn block_index(&self, b: [i64; 3]) -> Option<usize> {
-        let r = [0, 1, 2].map(|a| b[a] - self.lo[a]);
-        if (0..3).any(|a| r[a] < 0 || r[a] >= self.n[a]) {
-            return None;
-        }
-        Some(((r[0] * self.n[1] + r[1]) * self.n[2] + r[2]) as usize)
+        crate::geom::block_index(self.lo, self.n, b)
     }
 
     fn block_of(&self, p: Vec3) -> [i64; 3] {

@@ -6,8 +6,9 @@
 //! Geometric Design 21, 2004).
 //!
 //! - [`cloud`]: points made ready (normals estimated and oriented, spacing, areas);
-//! - [`winding`]: fast generalised winding numbers of the oriented points;
-//! - [`geometry`]: the signed distance [`crate::field::Field`] of a scan, sampled into a grid;
+//! - [`geometry`]: the signed distance [`crate::field::Field`] of a scan (its sign by fast
+//!   generalised winding numbers of the oriented points, [`crate::geom::winding`]), sampled
+//!   into a grid;
 //! - [`material`]: features, the distance to them, laws and compositions;
 //! - [`job`]: geometry → grid → mesh (checked) → material distance, and the `.vdb` and meshes;
 //! - [`stack`]: voxel-print PNG stacks by error diffusion;
@@ -21,7 +22,6 @@ pub mod material;
 pub mod plane;
 pub mod preview;
 pub mod stack;
-pub mod winding;
 
 pub use geometry::Sign;
 pub use job::{Fgm, FgmJob, Geometry};

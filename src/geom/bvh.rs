@@ -195,10 +195,15 @@ impl Bvh {
 
     /// The distance from `p` to the nearest triangle, if nearer than `limit` (else `limit`).
     pub fn distance(&self, p: Vec3, limit: f64) -> f64 {
+        self.closest(p, limit).map_or(limit, |(_, d, _)| d)
+    }
+
+    /// The point of the triangles nearest `p`, its distance and its triangle (by its index in
+    /// [`Bvh::triangles`]), if nearer than `limit`.
+    pub fn closest(&self, p: Vec3, limit: f64) -> Option<(Vec3, f64, usize)> {
         let mut best2 = limit * limit;
-        let Some(root) = self.nodes.first() else {
-            return limit;
-        };
+        let mut best = None;
+        let root = self.nodes.first()?;
         let mut stack = Stack::<(u32, f64)>::new();
         stack.push((0, box_distance2(&root.bounds, p)));
         while let Some((i, d2)) = stack.pop() {
@@ -208,15 +213,22 @@ impl Bvh {
             let node = &self.nodes[i as usize];
             if node.count > 0 {
                 let first = node.first as usize;
-                for tri in &self.triangles[first..first + node.count as usize] {
-                    best2 = best2.min(triangle_distance2(p, tri));
+                for (k, tri) in self.triangles[first..first + node.count as usize]
+                    .iter()
+                    .enumerate()
+                {
+                    let q = closest_on_triangle(p, tri);
+                    let e = sub(p, q);
+                    if dot(e, e) < best2 {
+                        best2 = dot(e, e);
+                        best = Some((q, first + k));
+                    }
                 }
                 continue;
             }
             let (a, b) = (node.first, node.first + 1);
             let da = box_distance2(&self.nodes[a as usize].bounds, p);
             let db = box_distance2(&self.nodes[b as usize].bounds, p);
-            // The nearer child is visited first: pushed last.
             if da <= db {
                 stack.push((b, db));
                 stack.push((a, da));
@@ -225,7 +237,7 @@ impl Bvh {
                 stack.push((b, db));
             }
         }
-        best2.sqrt()
+        best.map(|(q, t)| (q, best2.sqrt(), t))
     }
 
     /// Whether `p` is inside the closed surface the triangles bound: an odd number of them
@@ -316,10 +328,17 @@ fn box_distance2(b: &Aabb, p: Vec3) -> f64 {
 
 /// The squared distance from `p` to the triangle (Ericson, Real-Time Collision Detection 5.1.5).
 pub(crate) fn triangle_distance2(p: Vec3, t: &[Vec3; 3]) -> f64 {
+    let q = closest_on_triangle(p, t);
+    let d = sub(p, q);
+    dot(d, d)
+}
+
+/// The point of the triangle `t` nearest `p` (Ericson, Real-Time Collision Detection 5.1.5).
+pub(crate) fn closest_on_triangle(p: Vec3, t: &[Vec3; 3]) -> Vec3 {
     let [a, b, c] = *t;
     let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
     let (d1, d2) = (dot(ab, ap), dot(ac, ap));
-    let q = if d1 <= 0.0 && d2 <= 0.0 {
+    if d1 <= 0.0 && d2 <= 0.0 {
         a
     } else {
         let bp = sub(p, b);
@@ -355,9 +374,7 @@ pub(crate) fn triangle_distance2(p: Vec3, t: &[Vec3; 3]) -> f64 {
                 }
             }
         }
-    };
-    let d = sub(p, q);
-    dot(d, d)
+    }
 }
 
 fn lerp(a: Vec3, d: Vec3, t: f64) -> Vec3 {

@@ -9,6 +9,7 @@ pub mod contour;
 mod mesh;
 pub mod topology;
 pub mod triangulate;
+pub mod winding;
 
 pub use mesh::*;
 
@@ -111,4 +112,19 @@ pub(crate) fn normalized(a: Vec3) -> Vec3 {
     } else {
         a
     }
+}
+
+/// The block at position `i` of the `n` blocks from `lo` (x slowest, z fastest).
+pub(crate) fn block_at(lo: [i64; 3], n: [i64; 3], i: usize) -> [i64; 3] {
+    let (i, [_, ny, nz]) = (i as i64, n);
+    [lo[0] + i / (ny * nz), lo[1] + (i / nz) % ny, lo[2] + i % nz]
+}
+
+/// The position of block `b` among the `n` blocks from `lo`, if it is one of them.
+pub(crate) fn block_index(lo: [i64; 3], n: [i64; 3], b: [i64; 3]) -> Option<usize> {
+    let r = [0, 1, 2].map(|a| b[a] - lo[a]);
+    if (0..3).any(|a| r[a] < 0 || r[a] >= n[a]) {
+        return None;
+    }
+    Some(((r[0] * n[1] + r[1]) * n[2] + r[2]) as usize)
 }

@@ -162,8 +162,20 @@ impl MeshFile {
             file: self.clone(),
             collector: MeshCollector::default(),
         };
+        let streamed = matches!(self.written, Written::Mesh(Format::Stl | Format::ThreeMf));
         let target = match self.written {
             Written::Mesh(_) if keeps => indexed(),
+            // Work that may be stopped opens its temporary only when the first triangles come,
+            // after checking the flag: a stopped run leaves nothing behind while its worker
+            // finishes the stage it was in.
+            _ if streamed && stop.is_some() => {
+                crate::io::atomic::check_writable(&self.path)?;
+                Target::Pending {
+                    file: self.clone(),
+                    stl,
+                    begun: None,
+                }
+            }
             Written::Mesh(Format::Stl) => Target::Stl(StlSink::create(&self.path, stl)?),
             Written::Mesh(Format::ThreeMf) => Target::ThreeMf(ThreeMfSink::create(&self.path)?),
             Written::Mesh(Format::Obj | Format::Off | Format::Ply) | Written::Vdb => indexed(),
@@ -256,6 +268,15 @@ enum Target {
     Stl(StlSink),
     /// 3MF, streamed.
     ThreeMf(ThreeMfSink),
+    /// STL or 3MF not yet opened (work that may be stopped): opened at the first triangles.
+    Pending {
+        /// The file to stream to.
+        file: MeshFile,
+        /// STL's flavour.
+        stl: StlFormat,
+        /// The count announced by `begin`, if it was called.
+        begun: Option<Option<u64>>,
+    },
     /// OBJ, OFF, PLY or `.vdb` (or any mesh kept): gathered, written (or kept) at commit.
     Indexed {
         /// The file to write.
@@ -267,13 +288,30 @@ enum Target {
 
 impl FileSink {
     /// Moves the finished file into place (or keeps the mesh).
-    pub fn commit(self) -> Result<()> {
+    pub fn commit(mut self) -> Result<()> {
         check_stop(self.stop.as_ref())?;
+        self.open()?;
         match self.target {
             Target::Stl(s) => s.commit(),
             Target::ThreeMf(s) => s.commit(),
             Target::Indexed { file, collector } => file.save_owned(collector.mesh),
+            Target::Pending { .. } => unreachable!("opened above"),
         }
+    }
+
+    /// Opens a pending STL or 3MF, announcing the count `begin` was given.
+    fn open(&mut self) -> Result<()> {
+        if let Target::Pending { file, stl, begun } = &self.target {
+            let begun = *begun;
+            self.target = match file.written {
+                Written::Mesh(Format::ThreeMf) => Target::ThreeMf(ThreeMfSink::create(&file.path)?),
+                _ => Target::Stl(StlSink::create(&file.path, *stl)?),
+            };
+            if let Some(n) = begun {
+                self.inner().begin(n)?;
+            }
+        }
+        Ok(())
     }
 
     /// Sets the voxel size of a `.vdb`'s level set (the part's own voxels), mm.
@@ -288,21 +326,29 @@ impl FileSink {
             Target::Stl(s) => s,
             Target::ThreeMf(s) => s,
             Target::Indexed { collector, .. } => collector,
+            Target::Pending { .. } => unreachable!("a pending sink is opened before use"),
         }
     }
 }
 
 impl MeshSink for FileSink {
     fn begin(&mut self, triangles: Option<u64>) -> Result<()> {
+        if let Target::Pending { begun, .. } = &mut self.target {
+            *begun = Some(triangles);
+            return Ok(());
+        }
         self.inner().begin(triangles)
     }
 
     fn triangles(&mut self, batch: &[Triangle]) -> Result<()> {
         check_stop(self.stop.as_ref())?;
+        self.open()?;
         self.inner().triangles(batch)
     }
 
     fn finish(&mut self) -> Result<()> {
+        check_stop(self.stop.as_ref())?;
+        self.open()?;
         self.inner().finish()
     }
 }

@@ -14,8 +14,9 @@
 //!   field's first-order distance `|f| / |∇f|` (the box's faces by their exact distance); and
 //!   the removed vertex lies within the tolerance of the triangles that replace its fan;
 //! * **shape**: no triangle turns over or away from the surface's normal by more than
-//!   [`MAX_NORMAL_DEGREES`], and none becomes a sliver (quality under [`MIN_QUALITY`] of the
-//!   equilateral's, unless it was one already);
+//!   [`MAX_NORMAL_DEGREES`], none becomes a sliver (quality under [`MIN_QUALITY`] of the
+//!   equilateral's, unless it was one already), and none grows an edge longer than
+//!   [`MAX_EDGE_VOXELS`] voxels;
 //! * **topology**: the link condition (the two vertices share exactly the two neighbours of
 //!   their edge), no vertex left with fewer than three neighbours, so the mesh stays a closed
 //!   2-manifold of the same genus and pieces;
@@ -41,6 +42,11 @@ pub const MIN_QUALITY: f64 = 0.1;
 
 /// Rounds of simplification at most (each after the previous one's crossings were locked).
 pub const MAX_ROUNDS: usize = 4;
+
+/// A new triangle's longest edge may be at most this many voxels: the samples a collapse is
+/// checked on grow with a triangle's area (a flat face of a part remeshed from a CAD file would
+/// otherwise merge into triangles of thousands of samples each).
+pub const MAX_EDGE_VOXELS: f64 = 12.0;
 
 /// The surface a mesh stands for: a field clipped by a box.
 #[derive(Clone, Copy)]
@@ -604,6 +610,12 @@ impl<'a> Collapser<'a> {
             }
             let q_new = quality(&new);
             if q_new < MIN_QUALITY * EQUILATERAL && q_new < quality(&old) {
+                return false;
+            }
+            let longest = (0..3)
+                .map(|k| norm(sub(new[k], new[(k + 1) % 3])))
+                .fold(0.0, f64::max);
+            if longest > MAX_EDGE_VOXELS * spacing {
                 return false;
             }
             let centroid = [0, 1, 2].map(|d| (new[0][d] + new[1][d] + new[2][d]) / 3.0);

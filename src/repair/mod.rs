@@ -12,7 +12,9 @@
 //! 7. Turn every closed shell outward (a cavity inward), by nesting parity.
 //! 8. Optionally drop the shells that are still open, and optionally remesh through OpenVDB.
 //! 9. For a solid (`--solid`): drop the open shells, join shells that intersect or overlap
-//!    (CGAL's corefinement, or a remesh of their group) — see [`solid`].
+//!    (CGAL's corefinement, or a remesh of their group) — see [`solid`]; or, where the open
+//!    shells enclose something together (a soup of open and overlapping pieces), make the whole
+//!    solid by its generalised winding number — see [`soup`].
 //!
 //! A mesh without defects passes through unchanged (same facets in the same order). A shell that
 //! stays open is reported, never dropped unless asked. Normals are recomputed by the writers.
@@ -22,10 +24,12 @@ mod file;
 mod holes;
 pub mod remesh;
 pub mod solid;
+pub mod soup;
 mod split;
 
 use crate::check;
 use crate::error::Result;
+use crate::field::Aabb;
 use crate::geom::topology::{BoundaryLoop, Shells, Topology};
 use crate::geom::{signed_volume, sub, Mesh};
 use crate::progress::Progress;
@@ -33,6 +37,15 @@ use crate::progress::Progress;
 pub use file::{repair_file, FileRepairReport};
 pub use holes::PLANAR_REL;
 pub use solid::SolidReport;
+
+/// With `solid`, open shells whose winding number exceeds ½ where the closed shells' does not,
+/// in at least this many cells of a grid of [`SOUP_GRID`]³ over them, enclose material that
+/// dropping them would lose: the part is a soup, made solid whole by its winding number.
+/// Otherwise they are strays beside the closed shells (or inside them), dropped, and the closed
+/// shells are joined exactly.
+pub const SOUP_CELLS: usize = 8;
+/// Cells per axis of the grid the open shells' enclosure is tested on.
+pub const SOUP_GRID: usize = 24;
 
 /// How to repair.
 #[derive(Debug, Clone, Copy)]
@@ -50,6 +63,10 @@ pub struct RepairOptions {
     pub remesh: Option<Remesh>,
     /// End in one valid closed solid: drop open shells, join intersecting ones ([`solid`]).
     pub solid: bool,
+    /// Simplify what a remesh made within this distance of the input's surface, mm (see
+    /// [`crate::mesh::simplify`]; the input's surface is its triangles, signed by their winding
+    /// number, [`soup`]).
+    pub tolerance: Option<f64>,
 }
 
 /// The voxel size of a remesh.
@@ -70,6 +87,7 @@ impl Default for RepairOptions {
             drop_open_shells: false,
             remesh: None,
             solid: false,
+            tolerance: None,
         }
     }
 }
@@ -92,7 +110,10 @@ pub struct OpenShell {
     pub boundary_edges: u64,
     /// Closed loops of boundary edges (holes).
     pub hole_loops: u64,
-    /// Whether the shell was dropped (`drop_open_shells`).
+    /// Its facets' area, mm².
+    pub area: f64,
+    /// Whether the shell was dropped (`drop_open_shells`, or `solid` where open shells are
+    /// strays beside the closed ones).
     pub dropped: bool,
 }
 
@@ -114,6 +135,10 @@ pub struct RepairReport {
     /// What making a solid did (`--solid`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub solid: Option<solid::SolidReport>,
+    /// How a remesh was simplified within the tolerance asked (`tolerance`), and how far it
+    /// lies from the input's surface.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simplified: Option<crate::mesh::pipeline::Simplified>,
 }
 
 /// The mesh being repaired, with its topology cached until the next change.
@@ -259,6 +284,49 @@ impl Work {
         Ok(st.failed)
     }
 
+    /// Whether dropping the shells still open would lose material: their winding number over
+    /// ½ (they enclose something together) where the closed shells' is not, in [`SOUP_CELLS`]
+    /// cells or more of a grid over them.
+    fn open_shells_enclose(&mut self) -> bool {
+        let (mesh, topo) = self.parts();
+        let shells = Shells::new(mesh, topo);
+        let (mut open, mut closed) = (Vec::new(), Vec::new());
+        for f in 0..mesh.triangle_count() {
+            match shells.of_facet[f] {
+                u32::MAX => {}
+                s if shells.edges[s as usize].closed() => closed.push(mesh.triangle(f)),
+                _ => open.push(mesh.triangle(f)),
+            }
+        }
+        if open.is_empty() {
+            return false;
+        }
+        let corner = |pick: fn(f64, f64) -> f64, start: f64| {
+            [0, 1, 2].map(|a| {
+                open.iter()
+                    .flat_map(|t| t.iter().map(move |p| p[a]))
+                    .fold(start, pick)
+            })
+        };
+        let (lo, hi) = (
+            corner(f64::min, f64::INFINITY),
+            corner(f64::max, f64::NEG_INFINITY),
+        );
+        let open_w = crate::geom::winding::Winding::of_triangles(&open);
+        let closed_w = crate::geom::winding::Winding::of_triangles(&closed);
+        let n = SOUP_GRID;
+        use rayon::prelude::*;
+        let lost = (0..n * n * n)
+            .into_par_iter()
+            .filter(|&i| {
+                let c = [i / (n * n), (i / n) % n, i % n];
+                let p = [0, 1, 2].map(|a| lo[a] + (hi[a] - lo[a]) * (c[a] as f64 + 0.5) / n as f64);
+                open_w.at(p) > 0.5 && closed_w.at(p) < 0.5
+            })
+            .count();
+        lost >= SOUP_CELLS
+    }
+
     /// Step 8: the shells still open, each with its holes; dropped with their facets when
     /// `drop` is set.
     fn open_shells(&mut self, drop: bool) -> Vec<OpenShell> {
@@ -280,10 +348,18 @@ impl Work {
                 .iter()
                 .filter(|l| l.closed && vs.contains(&l.vertices[0]))
                 .count() as u64;
+            let area = fs
+                .iter()
+                .map(|&f| {
+                    let [a, b, c] = mesh.triangle(f as usize);
+                    0.5 * crate::geom::norm(crate::geom::cross(sub(b, a), sub(c, a)))
+                })
+                .sum();
             open.push(OpenShell {
                 facets: fs.len() as u64,
                 boundary_edges: e.boundary + e.non_manifold,
                 hole_loops,
+                area,
                 dropped: drop,
             });
             dropped[s] = drop;
@@ -401,6 +477,66 @@ fn fold_caps(mesh: &mut Mesh, bad: &check::FacetDefects) -> u64 {
     folded
 }
 
+/// `mesh` (a remesh on `voxel` mm) simplified within `tolerance` of `surface`'s triangles
+/// (their winding-signed distance), its volume kept, and how far it lies from them.
+fn simplify_remesh(
+    mesh: &Mesh,
+    surface: &Mesh,
+    voxel: f64,
+    tolerance: f64,
+) -> (Mesh, crate::mesh::pipeline::Simplified) {
+    use crate::mesh::simplify::{self, Settings, Surface};
+    let bounds = surface
+        .bounds()
+        .into_iter()
+        .chain(mesh.bounds())
+        .reduce(|a, b| Aabb {
+            min: [0, 1, 2].map(|k| a.min[k].min(b.min[k])),
+            max: [0, 1, 2].map(|k| a.max[k].max(b.max[k])),
+        })
+        .unwrap_or(Aabb {
+            min: [0.0; 3],
+            max: [0.0; 3],
+        });
+    let spec = crate::grid::GridSpec::covering(&bounds, voxel, 3.0);
+    let field = soup::SoupField::new(surface, spec);
+    // The box lies beyond the part: nothing is on its faces.
+    let clip = bounds.grown(4.0 * voxel + 1.0);
+    let surface = Surface {
+        field: &field,
+        clip,
+    };
+    let uniform = simplify::deviation(mesh, surface, 0.25 * voxel);
+    // Where the measured deviation (sampled four times finer than each collapse is checked)
+    // exceeds the tolerance, simplified again at a smaller one, as a part is.
+    let (mut aim, mut best) = (tolerance, None);
+    for _ in 0..3 {
+        let settings = Settings {
+            tolerance: aim,
+            voxel,
+        };
+        let (out, stats) = simplify::simplify(mesh, surface, settings, Some(mesh.volume()));
+        let deviation = simplify::deviation(&out, surface, 0.25 * voxel);
+        let done = deviation <= tolerance.max(uniform);
+        best = Some((out, stats, deviation));
+        if done {
+            break;
+        }
+        aim *= 0.75;
+    }
+    let (out, stats, deviation) = best.expect("simplified once at least");
+    (
+        out,
+        crate::mesh::pipeline::Simplified {
+            stats: simplify::SimplifyStats { tolerance, ..stats },
+            deviation,
+            voxel,
+            uniform_deviation: uniform,
+            uniform_triangles: mesh.triangle_count() as u64,
+        },
+    )
+}
+
 /// Repairs `mesh`. Returns the repaired mesh and what was done.
 pub fn repair(
     mesh: &Mesh,
@@ -451,13 +587,40 @@ pub fn repair(
         let flipped = orient_outward(&mut w);
         w.note("shells turned outward", flipped);
     }
-    let open_shells = w.open_shells(opts.drop_open_shells || opts.solid);
+    // A solid from a soup: where the open shells together enclose something the closed ones do
+    // not, they are part of the part, and the whole is made solid by its winding number;
+    // otherwise they are strays beside the closed shells.
+    let soup = opts.solid && w.open_shells_enclose();
+    let open_shells = w.open_shells(opts.drop_open_shells || (opts.solid && !soup));
+    // The surface a remesh is simplified against: the repaired facets, before any remesh.
+    let before_remesh = opts.tolerance.map(|_| w.mesh.clone());
     let fixed_voxel = match opts.remesh {
         Some(Remesh::Voxel(v)) => Some(v),
         _ => None,
     };
     let mut remesh_voxel = None;
-    let solid_report = if opts.solid {
+    let solid_report = if soup {
+        let _s = progress.stage("making the pieces solid by their winding number");
+        let voxel = fixed_voxel.unwrap_or_else(|| remesh::voxel_for(&w.mesh, true, opts.tolerance));
+        let (m, active) = remesh::solidify(&w.mesh, voxel)?;
+        w.mesh = m;
+        w.topo = None;
+        w.note(
+            "open pieces made solid with the rest by their winding number",
+            open_shells.len() as u64,
+        );
+        remesh_voxel = Some(voxel);
+        if w.mesh.triangle_count() == 0 {
+            return Err(crate::error::Error::invalid(
+                "no solid: the pieces enclose nothing (their winding number is nowhere over ½: open sheets with no inside)",
+            ));
+        }
+        Some(SolidReport {
+            soup_active_voxels: Some(active),
+            voxel: Some(voxel),
+            ..SolidReport::default()
+        })
+    } else if opts.solid {
         if w.mesh.triangle_count() == 0 {
             return Err(crate::error::Error::invalid(
                 "no solid: nothing is closed enough to have an inside (every shell is open or degenerate)",
@@ -495,9 +658,24 @@ pub fn repair(
     let remesh_active = match (opts.remesh, opts.solid) {
         (Some(_), false) => {
             let _s = progress.stage("remeshing through OpenVDB");
-            let voxel = fixed_voxel.unwrap_or_else(|| remesh::auto_voxel(&w.mesh));
+            let voxel =
+                fixed_voxel.unwrap_or_else(|| remesh::voxel_for(&w.mesh, false, opts.tolerance));
             remesh_voxel = Some(voxel);
             Some(w.remesh(voxel)?)
+        }
+        _ => None,
+    };
+    let remeshed = remesh_active.is_some()
+        || solid_report.as_ref().is_some_and(|r| {
+            r.soup_active_voxels.is_some() || r.shells_remeshed > 0 || r.whole_part_remeshed
+        });
+    let simplified = match (opts.tolerance, before_remesh, remesh_voxel) {
+        (Some(tolerance), Some(surface), Some(voxel)) if remeshed => {
+            let _s = progress.stage("simplifying the remesh");
+            let (m, s) = simplify_remesh(&w.mesh, &surface, voxel, tolerance);
+            w.mesh = m;
+            w.topo = None;
+            Some(s)
         }
         _ => None,
     };
@@ -514,6 +692,7 @@ pub fn repair(
             remesh_voxel,
             remesh_active_voxels: remesh_active,
             solid: solid_report,
+            simplified,
         },
     ))
 }

@@ -52,6 +52,9 @@ pub struct SolidReport {
     pub whole_part_remeshed: bool,
     /// The voxel size of the remeshes, mm, when one ran.
     pub voxel: Option<f64>,
+    /// Active voxels of the level set a soup was made solid through (its open pieces more than
+    /// strays: the whole made solid by its winding number); `None` otherwise.
+    pub soup_active_voxels: Option<u64>,
     /// The mesh returned was searched for intersecting facet pairs and has none (the search the
     /// check of the written file may skip when the file holds the same facets).
     #[serde(skip)]
