@@ -27,7 +27,7 @@
 //!
 //! Seeded: a failure names its case N, and `LATVOX_CASE=N` runs that case alone. The main tier
 //! runs 6 cases (and 2 foams); the long tier (`cargo test --release -- --ignored
-//! implicit_slices`) 60 (and 12 foams).
+//! implicit_slices`) 30 (and 12 foams).
 
 use crate::common::*;
 use crate::density_property::{round, FEASIBLE};
@@ -291,9 +291,9 @@ fn implicit_slices_hold_the_mesh_at_random_settings() {
 }
 
 #[test]
-#[ignore = "long: sixty random parts sliced both ways"]
-fn implicit_slices_hold_the_mesh_at_sixty_random_settings() {
-    property(60);
+#[ignore = "long: thirty random parts sliced both ways"]
+fn implicit_slices_hold_the_mesh_at_thirty_random_settings() {
+    property(30);
 }
 
 /// Voronoi foams, nets and sheets, random and periodic, with and without pores.

@@ -72,7 +72,7 @@ fn the_python_package_installs_and_passes_its_tests() {
 }
 
 #[test]
-#[ignore = "long: a ten-million-triangle part returned to Python, its peak memory measured"]
+#[ignore = "long: a four-million-triangle part returned to Python, its peak memory measured"]
 fn the_python_package_returns_large_parts_without_doubling_memory() {
     pytest("long");
 }
