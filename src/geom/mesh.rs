@@ -88,7 +88,7 @@ impl Mesh {
     pub fn area(&self) -> f64 {
         ordered_sum(self.triangle_count(), |t| {
             let [a, b, c] = self.triangle(t);
-            0.5 * norm(cross(sub(b, a), sub(c, a)))
+            triangle_area(a, b, c)
         })
     }
 
@@ -267,6 +267,11 @@ pub(crate) fn clipped_column_integral(tri: [Vec3; 3], b: &Aabb) -> f64 {
 /// it spans with the origin, mm³ (summed over a closed, outward mesh: the enclosed volume).
 pub fn signed_volume(a: Vec3, b: Vec3, c: Vec3) -> f64 {
     dot(a, cross(b, c)) / 6.0
+}
+
+/// Triangle `abc`'s area, mm².
+pub fn triangle_area(a: Vec3, b: Vec3, c: Vec3) -> f64 {
+    0.5 * norm(cross(sub(b, a), sub(c, a)))
 }
 
 pub(crate) fn sub(a: Vec3, b: Vec3) -> Vec3 {

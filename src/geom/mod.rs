@@ -51,6 +51,14 @@ impl Aabb {
         (0..3).all(|a| p[a] >= self.min[a] && p[a] <= self.max[a])
     }
 
+    /// The smallest box holding both.
+    pub fn union(&self, o: &Aabb) -> Aabb {
+        Aabb {
+            min: [0, 1, 2].map(|k| self.min[k].min(o.min[k])),
+            max: [0, 1, 2].map(|k| self.max[k].max(o.max[k])),
+        }
+    }
+
     /// The box grown by `m` on every side.
     pub fn grown(&self, m: f64) -> Aabb {
         Aabb {

@@ -352,7 +352,7 @@ impl Work {
                 .iter()
                 .map(|&f| {
                     let [a, b, c] = mesh.triangle(f as usize);
-                    0.5 * crate::geom::norm(crate::geom::cross(sub(b, a), sub(c, a)))
+                    crate::geom::triangle_area(a, b, c)
                 })
                 .sum();
             open.push(OpenShell {
@@ -490,10 +490,7 @@ fn simplify_remesh(
         .bounds()
         .into_iter()
         .chain(mesh.bounds())
-        .reduce(|a, b| Aabb {
-            min: [0, 1, 2].map(|k| a.min[k].min(b.min[k])),
-            max: [0, 1, 2].map(|k| a.max[k].max(b.max[k])),
-        })
+        .reduce(|a, b| a.union(&b))
         .unwrap_or(Aabb {
             min: [0.0; 3],
             max: [0.0; 3],
