@@ -388,7 +388,7 @@ fn caps_cones_balls_clipping_and_transforms_match_manifold3d() {
     const MANIFOLD: &str = r#"
 import json, sys, numpy as np, manifold3d as m3
 d = json.load(open(sys.argv[1]))
-N = 256
+N = 96
 def solid(mesh):
     v = np.array(mesh["vertices"], dtype=np.float32)
     t = np.array(mesh["triangles"], dtype=np.uint32)

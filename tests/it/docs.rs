@@ -174,18 +174,20 @@ fn run_page(page: &Path, long: bool) -> (usize, Vec<String>) {
         .display()
         .to_string();
     let text = std::fs::read_to_string(page).unwrap();
-    let steps = steps(&name, &text);
+    let mut steps = steps(&name, &text);
     if !steps.iter().any(|s| matches!(s, Step::Run { .. })) {
         return (0, Vec::new());
     }
-    // The long tier runs the pages that have long examples (with the examples before them,
-    // which may make their inputs); the main tier has run every other page already.
-    if long
-        && !steps
+    // The long tier runs the pages that have long examples, up to the last of them (with the
+    // examples before them, which may make their inputs); the main tier has run the rest.
+    if long {
+        match steps
             .iter()
-            .any(|s| matches!(s, Step::Run { long: true, .. }))
-    {
-        return (0, Vec::new());
+            .rposition(|s| matches!(s, Step::Run { long: true, .. }))
+        {
+            Some(last) => steps.truncate(last + 1),
+            None => return (0, Vec::new()),
+        }
     }
     let dir = tempdir();
     copy_dir(&root().join("docs/examples"), dir.path());
@@ -260,8 +262,10 @@ fn run_page(page: &Path, long: bool) -> (usize, Vec<String>) {
                         failures.push(format!("{at}: wrote no {f}"));
                     }
                 }
-                if !long && seconds > 20.0 {
+                if !long && seconds > 8.0 {
                     eprintln!("{at}: {seconds:.1} s (mark its block <!-- example: long -->)");
+                } else {
+                    eprintln!("{at}: {seconds:.1} s");
                 }
             }
         }

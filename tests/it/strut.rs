@@ -28,14 +28,14 @@ fn triangles(c: &MeshCollector) -> Vec<Tri> {
 }
 
 /// The main tier makes every built-in cell at one of the three densities (each in turn); the long
-/// tier, at all three.
+/// tier, at the other two.
 #[test]
 fn every_built_in_cell_meets_a_density_closed_and_in_one_piece() {
     built_in_cells(false);
 }
 
 #[test]
-#[ignore = "long: every built-in cell at three densities, checked by CGAL"]
+#[ignore = "long: every built-in cell at the two densities the main tier leaves, checked by CGAL"]
 fn every_built_in_cell_meets_its_density_closed_and_in_one_piece() {
     built_in_cells(true);
 }
@@ -47,13 +47,11 @@ fn built_in_cells(all: bool) {
     let bounds = domain.bounds();
     let mut failures = Vec::new();
     for (turn, name) in latvox::strut::cell::BUILT_IN.iter().enumerate() {
-        let targets = [0.1, 0.2, 0.3];
-        let targets = if all {
-            &targets[..]
-        } else {
-            &targets[turn % 3..turn % 3 + 1]
-        };
-        for &target in targets {
+        for (t, &target) in [0.1, 0.2, 0.3].iter().enumerate() {
+            // The main tier's density in turn; the long tier's, the other two.
+            if all == (t == turn % 3) {
+                continue;
+            }
             let job = StrutJob {
                 grading: None,
                 cell: Arc::new(UnitCell::built_in(name).unwrap()),

@@ -122,13 +122,13 @@ fn property(seed: u64, cases: u64) {
 
 #[test]
 fn random_foams_meet_their_density_closed_and_in_one_piece() {
-    property(0x0f0a_2026, 4);
+    property(0x0f0a_2026, 3);
 }
 
 #[test]
-#[ignore = "long: twenty-four random foams"]
+#[ignore = "long: twelve random foams"]
 fn long_random_foams_meet_their_density_closed_and_in_one_piece() {
-    property(0x5eed_f0a5, 24);
+    property(0x5eed_f0a5, 12);
 }
 
 /// Runs `tests/reference/voronoi.py` (SciPy's Voronoi diagram of the seeds, points classified
@@ -606,16 +606,16 @@ fn a_periodic_foam_is_copied_from_its_cell_and_is_scipys_foam_in_every_cell() {
             d,
             &[
                 &seeds, &out, structure, level, "0.6", "-3", "1.5", "2", "23", "27.5", "28", "6.5",
-                "200",
+                "120",
             ],
         );
         eprintln!("{structure}: {s}");
         assert!(
-            s["member_points"].as_u64().unwrap() >= 150,
+            s["member_points"].as_u64().unwrap() >= 100,
             "{structure}: {s}"
         );
         assert_eq!(s["members_inside"], s["member_points"], "{structure}: {s}");
-        assert!(s["seeds"].as_u64().unwrap() >= 60, "{structure}: {s}");
+        assert!(s["seeds"].as_u64().unwrap() >= 50, "{structure}: {s}");
         assert_eq!(s["seeds_outside"], s["seeds"], "{structure}: {s}");
         if structure == "net" {
             // The same lattice from its cell file: the same volume.

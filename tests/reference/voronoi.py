@@ -7,7 +7,7 @@ usage: voronoi.py SEEDS.csv PART.stl net|sheet|pores LEVEL MARGIN X0 Y0 Z0 X1 Y1
   pores: the centroids of faces of inradius LEVEL or more (where a sheet's pores are);
   LEVEL: the strut radius or wall thickness (pores: the least inradius); MARGIN: how far inside the box points are taken;
   PERIOD: the seeds are one cell of this edge from the box's lower corner, repeated through the
-  box and a cell round it (a periodic foam); POINTS: how many member points to test (400; half
+  box and a cell round it (a periodic foam); POINTS: how many member points to test (150; half
   as many seeds).
 Prints JSON: the member points and how many lie inside, the seeds and how many lie outside.
 """
@@ -32,13 +32,20 @@ def segment_distance(p, a, b):
 
 
 def winding(tris, points):
+    # The corners' coordinates as nine contiguous arrays: plain element-wise arithmetic on them
+    # is several times faster than row-wise products on (n, 3) arrays.
+    t = [np.ascontiguousarray(tris[:, i, k]) for i in range(3) for k in range(3)]
     out = []
     for p in points:
-        a, b, c = tris[:, 0] - p, tris[:, 1] - p, tris[:, 2] - p
-        la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
-        det = np.einsum("ij,ij->i", a, np.cross(b, c))
-        div = (la * lb * lc + np.einsum("ij,ij->i", a, b) * lc
-               + np.einsum("ij,ij->i", b, c) * la + np.einsum("ij,ij->i", c, a) * lb)
+        ax, ay, az = t[0] - p[0], t[1] - p[1], t[2] - p[2]
+        bx, by, bz = t[3] - p[0], t[4] - p[1], t[5] - p[2]
+        cx, cy, cz = t[6] - p[0], t[7] - p[1], t[8] - p[2]
+        la = np.sqrt(ax * ax + ay * ay + az * az)
+        lb = np.sqrt(bx * bx + by * by + bz * bz)
+        lc = np.sqrt(cx * cx + cy * cy + cz * cz)
+        det = ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx)
+        div = (la * lb * lc + (ax * bx + ay * by + az * bz) * lc
+               + (bx * cx + by * cy + bz * cz) * la + (cx * ax + cy * ay + cz * az) * lb)
         out.append(np.arctan2(det, div).sum() / (2 * np.pi))
     return np.array(out)
 
@@ -86,8 +93,8 @@ def main():
             if inradius >= level:
                 members.append(centre)
     members = [p for p in members if within(p)]
-    # Some hundreds of points spread over the box are plenty: keep the test quick.
-    n = int(sys.argv[13]) if len(sys.argv) > 13 else 400
+    # A hundred and fifty points spread over the box are plenty: keep the test quick.
+    n = int(sys.argv[13]) if len(sys.argv) > 13 else 150
     members = np.array(members[:: max(1, len(members) // n)][:n])
     far = np.array([s for s in seeds if within(s)])
     far = far[:: max(1, len(far) // (n // 2))]
