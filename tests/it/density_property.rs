@@ -231,19 +231,10 @@ fn property(seed: u64, cases: std::ops::Range<usize>, full: bool) {
     let dir = tempdir();
     let mut rng = Rng(seed);
     let mut failures = Vec::new();
-    // LATVOX_CASE=N runs case N of the sequence alone (a failure names its N).
-    let only: Option<usize> = std::env::var("LATVOX_CASE")
-        .ok()
-        .and_then(|v| v.parse().ok());
-    // (LATVOX_CASE may name a case past the tier's: the sequence is drawn that far.)
-    let end = only.map_or(cases.end, |n| n + 1);
-    for i in 0..end {
+    let cases = Cases::new(cases);
+    for i in 0..cases.end() {
         let c = draw(&mut rng, full);
-        let wanted = match only {
-            Some(n) => n == i,
-            None => cases.contains(&i),
-        };
-        if !wanted {
+        if !cases.runs(i) {
             continue;
         }
         let t = std::time::Instant::now();

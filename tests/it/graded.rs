@@ -547,17 +547,18 @@ fn random_voronoi_foams_are_graded_block_by_block() {
 /// random part.
 #[test]
 fn strut_lattices_are_graded_for_a_random_setting() {
-    strut_gradings(0..1, true);
+    strut_gradings(0..1);
+    octet_graded_by_an_expression();
 }
 
 #[test]
 #[ignore = "long: a second random strut grading"]
 fn strut_lattices_are_graded_for_every_setting() {
-    strut_gradings(1..2, false);
+    strut_gradings(1..2);
 }
 
-/// The random settings `random` of the seeded sequence, and the octet if `octet`.
-fn strut_gradings(random: std::ops::Range<usize>, octet: bool) {
+/// The random settings `random` of the seeded sequence.
+fn strut_gradings(random: std::ops::Range<usize>) {
     let mut rng = Rng(0x57_2a7);
     for i in 0..random.end {
         let name = ["bcc", "octet", "kelvin", "fccz"][rng.below(4) as usize];
@@ -596,9 +597,10 @@ fn strut_gradings(random: std::ops::Range<usize>, octet: bool) {
             &|p| a + (b - a) * ((p[axis] - origin[axis]) / size[axis]).clamp(0.0, 1.0),
         );
     }
-    if !octet {
-        return;
-    }
+}
+
+/// An octet truss graded by an expression, its joints blended.
+fn octet_graded_by_an_expression() {
     check_graded(
         &[
             "strut",
@@ -660,76 +662,32 @@ fn an_expression_field_is_met_cell_by_cell() {
 /// long tier) a .npy file.
 #[test]
 fn partial_cells_odd_origins_and_a_sampled_field() {
-    partial_cells_and_sampled_fields(false);
-}
-
-#[test]
-#[ignore = "long: a field sampled in a .npy file"]
-fn a_field_sampled_in_a_npy_file_is_met_cell_by_cell() {
-    partial_cells_and_sampled_fields(true);
-}
-
-/// The partial cells and the .vdb field, or (`only_npy`) the .npy field.
-fn partial_cells_and_sampled_fields(only_npy: bool) {
-    if !only_npy {
-        check_graded(
-            &[
-                "tpms",
-                "--type",
-                "d",
-                "--structure",
-                "sheet",
-                "--density-grade",
-                "x:0.12:0.3",
-                "--size",
-                "23,17,12",
-                "--cell-size",
-                "6",
-                "--origin",
-                "-3.3,2.1,7",
-                "-r",
-                "16",
-            ],
-            [-3.3, 2.1, 7.0],
-            [6.0; 3],
-            [23.0, 17.0, 12.0],
-            &|p| 0.12 + 0.18 * (p[0] + 3.3) / 23.0,
-        );
-    }
-    // 3×4×5 samples spanning a 3×4×4-cell box of 5 mm: 0.25 + 0.05·j, steps along y.
-    let dir = tempdir();
-    let data: Vec<f64> = (0..60)
-        .map(|n| 0.25 + 0.05 * ((n / 5) % 4) as f64)
-        .collect();
-    let npy = dir.path().join("field.npy");
-    let mut bytes = Vec::new();
-    latvox::io::npy::write(&mut bytes, &[3, 4, 5], &data).unwrap();
-    std::fs::write(&npy, bytes).unwrap();
-    if only_npy {
-        check_graded(
-            &[
-                "tpms",
-                "--type",
-                "p",
-                "--density-field",
-                npy.to_str().unwrap(),
-                "--cells",
-                "3,4,4",
-                "--cell-size",
-                "5",
-                "-r",
-                "24",
-            ],
-            [0.0; 3],
-            [5.0; 3],
-            [15.0, 20.0, 20.0],
-            // Trilinear between samples 20/3 mm apart along y.
-            &|p| 0.25 + 0.05 * (p[1] / (20.0 / 3.0)).clamp(0.0, 3.0),
-        );
-        return;
-    }
+    check_graded(
+        &[
+            "tpms",
+            "--type",
+            "d",
+            "--structure",
+            "sheet",
+            "--density-grade",
+            "x:0.12:0.3",
+            "--size",
+            "23,17,12",
+            "--cell-size",
+            "6",
+            "--origin",
+            "-3.3,2.1,7",
+            "-r",
+            "16",
+        ],
+        [-3.3, 2.1, 7.0],
+        [6.0; 3],
+        [23.0, 17.0, 12.0],
+        &|p| 0.12 + 0.18 * (p[0] + 3.3) / 23.0,
+    );
     // A .vdb made by OpenVDB's Python module: a grid of 0.8 mm voxels whose index (0, 0, 0) sits
     // at -1.2 mm, holding 0.15 + 0.01·z at each voxel's centre.
+    let dir = tempdir();
     let vdb = dir.path().join("field.vdb");
     write_vdb_field(&vdb, "g = vdb.FloatGrid(); g.name = 'density'");
     check_graded(
@@ -748,6 +706,40 @@ fn partial_cells_and_sampled_fields(only_npy: bool) {
         [5.0; 3],
         [15.0, 15.0, 20.0],
         &|p| 0.15 + 0.01 * p[2],
+    );
+}
+
+#[test]
+#[ignore = "long: a field sampled in a .npy file"]
+fn a_field_sampled_in_a_npy_file_is_met_cell_by_cell() {
+    // 3×4×5 samples spanning a 3×4×4-cell box of 5 mm: 0.25 + 0.05·j, steps along y.
+    let dir = tempdir();
+    let data: Vec<f64> = (0..60)
+        .map(|n| 0.25 + 0.05 * ((n / 5) % 4) as f64)
+        .collect();
+    let npy = dir.path().join("field.npy");
+    let mut bytes = Vec::new();
+    latvox::io::npy::write(&mut bytes, &[3, 4, 5], &data).unwrap();
+    std::fs::write(&npy, bytes).unwrap();
+    check_graded(
+        &[
+            "tpms",
+            "--type",
+            "p",
+            "--density-field",
+            npy.to_str().unwrap(),
+            "--cells",
+            "3,4,4",
+            "--cell-size",
+            "5",
+            "-r",
+            "24",
+        ],
+        [0.0; 3],
+        [5.0; 3],
+        [15.0, 20.0, 20.0],
+        // Trilinear between samples 20/3 mm apart along y.
+        &|p| 0.25 + 0.05 * (p[1] / (20.0 / 3.0)).clamp(0.0, 3.0),
     );
 }
 

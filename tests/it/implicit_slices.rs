@@ -257,21 +257,14 @@ fn property(cases: std::ops::Range<usize>) {
 
 /// The cases `cases` of the sequence `draw` makes from `seed`.
 fn property_of(cases: std::ops::Range<usize>, seed: u64, draw: fn(&mut Rng) -> Case) {
-    let only: Option<usize> = std::env::var("LATVOX_CASE")
-        .ok()
-        .map(|s| s.parse().unwrap());
     let mut rng = Rng(seed);
     let (mut done, mut refused) = (0, 0);
     let (mut volume_worst, mut layer_worst): (f64, f64) = (0.0, 0.0);
-    // (LATVOX_CASE may name a case past the tier's: the sequence is drawn that far.)
-    let end = only.map_or(cases.end, |k| k + 1);
-    for n in 0..end {
+    let tier = cases.len();
+    let cases = Cases::new(cases);
+    for n in 0..cases.end() {
         let c = draw(&mut rng);
-        let wanted = match only {
-            Some(k) => k == n,
-            None => cases.contains(&n),
-        };
-        if !wanted {
+        if !cases.runs(n) {
             continue;
         }
         let dir = tempdir();
@@ -290,7 +283,7 @@ fn property_of(cases: std::ops::Range<usize>, seed: u64, draw: fn(&mut Rng) -> C
         100.0 * layer_worst
     );
     assert!(
-        only.is_some() || done * 4 >= cases.len() * 3,
+        cases.only.is_some() || done * 4 >= tier * 3,
         "too few cases ran"
     );
 }

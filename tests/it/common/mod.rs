@@ -302,3 +302,32 @@ pub fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {
     buf.truncate(info.buffer_size());
     (info.width, info.height, buf)
 }
+
+/// The cases of a seeded sweep this run makes: the tier's `range`, or the one case
+/// `LATVOX_CASE=N` names (a failure names its N), past the range too.
+pub struct Cases {
+    range: std::ops::Range<usize>,
+    pub only: Option<usize>,
+}
+
+impl Cases {
+    pub fn new(range: std::ops::Range<usize>) -> Cases {
+        let only = std::env::var("LATVOX_CASE")
+            .ok()
+            .and_then(|v| v.parse().ok());
+        Cases { range, only }
+    }
+
+    /// How far the sequence is drawn.
+    pub fn end(&self) -> usize {
+        self.only.map_or(self.range.end, |n| n + 1)
+    }
+
+    /// Whether case `i` runs.
+    pub fn runs(&self, i: usize) -> bool {
+        match self.only {
+            Some(n) => n == i,
+            None => self.range.contains(&i),
+        }
+    }
+}
