@@ -77,6 +77,7 @@ pub(crate) const COMMAND: Command = Command {
             "2d",
             "mesh",
             "voxel",
+            "tolerance",
             "sign",
             "feature",
             "weights",
@@ -148,6 +149,12 @@ pub struct FgmArgs {
     /// Voxel edge, mm (default: the part's longest side / 128).
     #[arg(long, value_name = "MM", value_parser = parse_positive, allow_hyphen_values = true)]
     pub voxel: Option<f64>,
+    /// Simplify the part's mesh within this distance of its surface, mm (of the input mesh with
+    /// --mesh; of the surface meshed from a scan's distance field): large triangles where it is
+    /// flat, the volume kept, the deviation measured and reported. Default: the uniform mesh,
+    /// two triangles per voxel the surface crosses.
+    #[arg(long, value_name = "MM", value_parser = parse_positive, allow_hyphen_values = true)]
+    pub tolerance: Option<f64>,
     /// How a scan's inside is told from its outside away from the points.
     #[arg(long, value_enum, default_value = "winding")]
     pub sign: Sign,
@@ -225,6 +232,7 @@ pub struct FgmReport {
     volume: Option<f64>,
     /// The part mesh's verification (the job's verdict).
     pub checks: latvox::verify::cgal::Verification,
+    simplified: Option<latvox::mesh::simplify::Simplified>,
     stack: Option<StackReport>,
     outputs: Vec<String>,
     timings: serde_json::Map<String, serde_json::Value>,
@@ -370,6 +378,7 @@ impl FgmArgs {
             composition,
             dmax: self.dmax,
             verify: self.verify,
+            tolerance: self.tolerance,
         })
     }
 
@@ -677,6 +686,7 @@ pub fn execute(a: &FgmArgs, progress: &Progress) -> Result<FgmReport> {
         vertices: fgm.mesh.vertex_count(),
         volume: fgm.checks.volume,
         checks: fgm.checks,
+        simplified: fgm.simplified,
         stack,
         outputs,
         timings,
@@ -721,6 +731,13 @@ fn print_summary(r: &FgmReport) {
         r.triangles,
         r.volume.unwrap_or(f64::NAN)
     );
+    if let Some(s) = &r.simplified {
+        let from = match r.geometry.source {
+            "mesh" => "the input mesh",
+            _ => "the uniform mesh",
+        };
+        super::out::simplified(s, "uniform mesh", from);
+    }
     outln!(
         "verified  {}  (by {})",
         cgal_findings(&r.checks),

@@ -25,6 +25,9 @@ Examples:
   # The same, smoothed by two passes of OpenVDB's Gaussian level-set filter
   latvox interpret bracket3d.npy --element-size 1 --refine 2 --smooth 2 -o bracket-smooth.stl
 
+  # A 3D field's mesh simplified within 0.1 mm of the surface: a fraction of the triangles
+  latvox interpret bracket3d.npy --element-size 1 --refine 2 --tolerance 0.1 -o bracket-small.stl
+
 Input: .npy (float, int or bool; C or Fortran order), .csv (2D, one row per line) or text with a
 dimension header line `ny nx [nz]` then the values. 2D arrays are (ny, nx) with row 0 at the
 top, as the 88-line code's xPhys; 3D arrays (ny, nx, nz), as top3d's. Densities in [0, 1].
@@ -102,7 +105,11 @@ pub struct InterpretArgs {
     /// Extrusion of a 2D field, mm (default: one element).
     #[arg(long, value_name = "MM")]
     pub thickness: Option<f64>,
-    /// Max deviation of the CAD curves from the boundary, mm (default: half a refined pixel).
+    /// 2D: the largest deviation of the CAD curves from the boundary, mm (default: half a
+    /// refined pixel). 3D: simplify the mesh within this distance of the density's iso-surface
+    /// (of the smoothed surface with --smooth): large triangles where it is flat, the volume
+    /// kept, the deviation measured and reported (default: the uniform mesh, two triangles per
+    /// voxel the surface crosses).
     #[arg(long, value_name = "MM")]
     pub tolerance: Option<f64>,
     /// Output, in the format its extension names: a mesh (.stl, .obj, .off, .ply, .3mf) or the
@@ -254,6 +261,17 @@ fn summary(r: &job::InterpretReport, a: &InterpretArgs, images: &[PathBuf]) {
         cgal_findings(&r.checks),
         r.checks.checked_by
     );
+    if let Some(s) = &r.simplified {
+        super::out::simplified(
+            s,
+            "uniform mesh",
+            if r.job.smooth_iterations > 0 {
+                "the smoothed uniform mesh"
+            } else {
+                "the iso-surface"
+            },
+        );
+    }
     if !r.loops.is_empty() {
         outln!(
             "curves    {} loop(s): uniform {} control points, adaptive {} ({:.0} %), tolerance {} mm",

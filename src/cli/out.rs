@@ -54,3 +54,18 @@ pub(crate) fn json<T: serde::Serialize>(value: &T) {
         serde_json::to_string_pretty(value).expect("JSON of plain values")
     );
 }
+
+/// Prints the line of a mesh simplified within a tolerance: `of` names the uniform mesh it was
+/// made from ("remesh"), `from` the surface its deviation is measured from.
+pub(crate) fn simplified(s: &latvox::mesh::simplify::Simplified, of: &str, from: &str) {
+    let st = &s.stats;
+    outln!(
+        "simplified {} of the {of}'s {} triangles ({:.1}× fewer); deviation {:.4} mm from {from} measured, tolerance {} mm (the {of}'s own {:.4} mm)",
+        st.triangles_after,
+        st.triangles_before,
+        st.triangles_before as f64 / st.triangles_after.max(1) as f64,
+        s.deviation,
+        st.tolerance,
+        s.uniform_deviation
+    );
+}

@@ -215,16 +215,7 @@ pub fn run(a: &RepairArgs, quiet: bool) -> Result<i32> {
             outln!("voxel     {v:.4} mm (remesh)");
         }
         if let Some(sm) = &changes.simplified {
-            let st = &sm.stats;
-            outln!(
-                "simplified {} of the remesh's {} triangles ({:.1}× fewer); deviation {:.4} mm from the input's surface measured, tolerance {} mm (the remesh's own {:.4} mm)",
-                st.triangles_after,
-                st.triangles_before,
-                st.triangles_before as f64 / st.triangles_after.max(1) as f64,
-                sm.deviation,
-                st.tolerance,
-                sm.uniform_deviation
-            );
+            super::out::simplified(sm, "remesh", "the input's surface");
         } else if a.tolerance.is_some() {
             outln!("simplified nothing: no remesh was made (the facets are the input's own)");
         }

@@ -13,7 +13,9 @@ use crate::grid::{Grid, GridSpec};
 use crate::io::points::PointCloud;
 use crate::mesh::extract::KeyedMesh;
 use crate::mesh::pipeline::HALF_WIDTH;
+use crate::mesh::simplify::Simplified;
 use crate::progress::Progress;
+use crate::repair::simplify_to_mesh;
 use crate::verify::cgal::Verification;
 use crate::verify::{verify, Verify};
 use rayon::prelude::*;
@@ -47,6 +49,9 @@ pub struct FgmJob {
     pub dmax: Option<f64>,
     /// How the part's mesh is verified.
     pub verify: Verify,
+    /// Simplify the part's mesh within this distance of the part's surface, mm (`None`: the
+    /// uniform mesh).
+    pub tolerance: Option<f64>,
 }
 
 /// What the geometry stage found.
@@ -91,6 +96,8 @@ pub struct Fgm {
     pub geometry: GeometryReport,
     /// The mesh's verification.
     pub checks: Verification,
+    /// Set when the mesh was simplified within the job's tolerance.
+    pub simplified: Option<Simplified>,
     /// Seconds per stage.
     pub timings: Vec<(&'static str, f64)>,
 }
@@ -176,6 +183,20 @@ impl FgmJob {
             ));
         }
         drop(stage);
+        let (mesh, simplified) = match self.tolerance {
+            Some(tolerance) => {
+                let _s = progress.stage("simplifying");
+                // A mesh is the part's surface itself; a scan's points are noisy samples of
+                // one, and the part is the surface meshed from their distance field.
+                let surface = match &self.geometry {
+                    Geometry::Mesh(input) => input,
+                    _ => &mesh,
+                };
+                let (m, s) = simplify_to_mesh(&mesh, surface, self.voxel, tolerance);
+                (m, Some(s))
+            }
+            None => (mesh, None),
+        };
         let checks = verify(&mesh, self.verify, progress)?;
         timings.push(("mesh and verify", t.elapsed().as_secs_f64()));
 
@@ -245,6 +266,7 @@ impl FgmJob {
             distance_grid,
             geometry,
             checks,
+            simplified,
             timings,
         })
     }

@@ -29,7 +29,8 @@ pub struct InterpretOptions {
     pub max_iterations: usize,
     /// Extrusion of a 2D field, mm (default: one element).
     pub thickness: Option<f64>,
-    /// Max deviation of the CAD curves from the boundary, mm (default: half a refined pixel).
+    /// 2D: max deviation of the CAD curves from the boundary, mm (default: half a refined
+    /// pixel). 3D: the mesh is simplified within it of the surface (default: not simplified).
     pub tolerance: Option<f64>,
     /// 3D: passes of OpenVDB's level-set smoothing before meshing (0: none).
     pub smooth_iterations: u32,
@@ -62,6 +63,7 @@ impl InterpretOptions {
                 "--tolerance must be a positive length in mm",
             ));
         }
+        let mesh_tolerance = if d.is_3d { self.tolerance } else { None };
         if self.max_iterations == 0 {
             return Err(Error::invalid("--max-iterations must be at least 1"));
         }
@@ -84,6 +86,7 @@ impl InterpretOptions {
             },
             thickness: self.thickness.unwrap_or(self.element_size),
             tolerance,
+            mesh_tolerance,
             fit_curves: !d.is_3d,
             verify: self.verify,
             smooth_iterations: self.smooth_iterations,

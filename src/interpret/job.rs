@@ -10,6 +10,7 @@ use crate::cad::fit;
 use crate::error::Result;
 use crate::geom::Mesh;
 use crate::grid::Smoothing;
+use crate::mesh::simplify::Simplified;
 use crate::progress::Progress;
 use crate::verify::cgal::Verification;
 use crate::verify::Verdict;
@@ -25,6 +26,9 @@ pub struct InterpretJob {
     pub thickness: f64,
     /// Max deviation of the CAD curves from the boundary points, mm.
     pub tolerance: f64,
+    /// 3D: simplify the mesh within this distance of the surface it stands for, mm (`None`:
+    /// the uniform mesh, two triangles per voxel the surface crosses).
+    pub mesh_tolerance: Option<f64>,
     /// Fit the CAD curves (2D only).
     pub fit_curves: bool,
     /// How the 3D part is verified.
@@ -120,6 +124,8 @@ pub struct InterpretReport {
     pub triangles: usize,
     /// Vertices of the mesh.
     pub vertices: usize,
+    /// Set when the 3D mesh was simplified within `--tolerance`.
+    pub simplified: Option<Simplified>,
     /// CGAL's checks of the mesh.
     pub checks: Verification,
     /// The mesh's volume as CGAL measures it, mm³ (`null` when it is not closed).
@@ -200,6 +206,19 @@ pub fn run(d: &Density, job: &InterpretJob, progress: &Progress) -> Result<Inter
         let _s = progress.stage("meshing");
         mesh_solid(d, job, &mut cleaned)?
     };
+    let (mesh, simplified) = match job.mesh_tolerance {
+        Some(tolerance) if d.is_3d => {
+            let _s = progress.stage("simplifying");
+            let (m, s) = if job.smooth_iterations > 0 {
+                // The smoothed surface exists only as its grid: held to its uniform mesh.
+                crate::repair::simplify_to_mesh(&mesh, &mesh, cleaned.field.h, tolerance)
+            } else {
+                volume::simplified(&cleaned.field, cleaned.level, &mesh, tolerance)
+            };
+            (m, Some(s))
+        }
+        _ => (mesh, None),
+    };
     timings.mesh = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let checks = {
@@ -219,6 +238,7 @@ pub fn run(d: &Density, job: &InterpretJob, progress: &Progress) -> Result<Inter
     timings.total = t0.elapsed().as_secs_f64();
     let report = InterpretReport {
         timings,
+        simplified,
         ..report(d, job, &cleaned, &mesh, &loops, checks, fits.loops)
     };
     Ok(InterpretResult {
@@ -367,6 +387,7 @@ fn report(
         triangles: mesh.triangle_count(),
         vertices: mesh.vertex_count(),
         mesh_volume: checks.volume,
+        simplified: None,
         checks,
         loops: fits,
         uniform_control_points: uc,

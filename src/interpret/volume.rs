@@ -13,6 +13,7 @@ use crate::error::Result;
 use crate::field::{Aabb, Field, Intersection, Vec3};
 use crate::geom::Mesh;
 use crate::grid::{Grid, GridSpec, Smoothing};
+use crate::mesh::simplify::{self, Simplified, Surface};
 
 /// The iso-surface `ρ = level` of a 3D raster.
 pub struct DensityField<'a> {
@@ -123,18 +124,34 @@ pub fn mesh(grid: &Raster, level: f64) -> Result<Mesh> {
 /// The iso-surface of a 3D raster at `level` as a narrow-band level set at the raster's voxel
 /// size.
 fn sample(grid: &Raster, level: f64) -> Result<Grid> {
-    let top = grid.data.iter().copied().fold(1.0f64, f64::max);
-    let f = DensityField { grid, level, top };
-    let h = grid.h;
-    let bounds = Aabb {
-        min: [0.0; 3],
-        max: [0, 1, 2].map(|a| grid.n[a] as f64 * h),
-    };
-    let spec = GridSpec::covering(&bounds, h, 3.0);
+    let (f, bounds) = iso_surface(grid, level);
+    let spec = GridSpec::covering(&bounds, grid.h, 3.0);
     // Clipped by the domain box, whose exact distance closes the part where it meets the
     // domain's faces (the density alone drops to void there without a distance-like ramp).
     let clipped = Intersection { a: f, b: bounds };
     Grid::sample(&clipped, spec)
+}
+
+/// The iso-surface of `grid` at `level` and the domain box that clips it.
+fn iso_surface(grid: &Raster, level: f64) -> (DensityField<'_>, Aabb) {
+    let top = grid.data.iter().copied().fold(1.0f64, f64::max);
+    let bounds = Aabb {
+        min: [0.0; 3],
+        max: [0, 1, 2].map(|a| grid.n[a] as f64 * grid.h),
+    };
+    (DensityField { grid, level, top }, bounds)
+}
+
+/// `mesh`, made by [`mesh`] from `grid` at `level`, simplified within `tolerance` of that
+/// iso-surface (clipped by the domain, whose faces stay flat and their edges sharp), its volume
+/// kept ([`crate::mesh::simplify::mesh_within`]).
+pub fn simplified(grid: &Raster, level: f64, mesh: &Mesh, tolerance: f64) -> (Mesh, Simplified) {
+    let (field, clip) = iso_surface(grid, level);
+    let surface = Surface {
+        field: &field,
+        clip,
+    };
+    simplify::mesh_within(mesh, surface, grid.h, tolerance)
 }
 
 /// Half width, in voxels, of the smoothed level set's band: room for the filter's stencils and

@@ -29,6 +29,7 @@ use crate::io::sink::{Measures, MeshSink, Triangle};
 use crate::mesh::extract::KeyedMesh;
 use crate::mesh::instance::{self, AxisPlan, Template};
 use crate::mesh::pieces::{self, Fragments};
+pub use crate::mesh::simplify::Simplified;
 use crate::mesh::simplify::{self, SimplifyStats, Surface};
 use crate::mesh::snap::SnapStats;
 use crate::mesh::tile;
@@ -801,24 +802,6 @@ pub struct Instancing {
     pub verified: &'static str,
 }
 
-/// How the mesh was simplified, and how far it lies from the exact surface.
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct Simplified {
-    /// What simplification did.
-    #[serde(flatten)]
-    pub stats: SimplifyStats,
-    /// The largest distance from points sampled on the written mesh (a quarter voxel apart) to
-    /// the exact surface, mm.
-    pub deviation: f64,
-    /// The voxel the simplified mesh was made on, mm: finer than the part's where its uniform
-    /// mesh strayed further than the tolerance.
-    pub voxel: f64,
-    /// The largest deviation of the uniform mesh on the part's voxels, mm.
-    pub uniform_deviation: f64,
-    /// Triangles of the uniform mesh on the part's voxels.
-    pub uniform_triangles: u64,
-}
-
 /// How the part was meshed when it was meshed in tiles (see [`crate::mesh::tile`]).
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Tiling {
@@ -968,18 +951,9 @@ fn simplify_part<S: Solid>(
         uniform_deviation: requested_deviation,
         uniform_triangles: requested_triangles,
     };
-    let mut aim = tolerance;
-    for _ in 0..3 {
-        let settings = simplify::Settings {
-            tolerance: aim,
-            voxel: used,
-        };
-        let (out, stats) = simplify::simplify(&base, surface, settings, Some(volume));
-        let deviation = simplify::deviation(&out, surface, 0.25 * used);
-        if deviation <= bound {
-            return Ok((out, report(stats, deviation)));
-        }
-        aim *= 0.75;
+    let w = simplify::within(&base, surface, used, tolerance, bound, Some(volume));
+    if w.kept {
+        return Ok((w.mesh, report(w.stats, w.deviation)));
     }
     let still = vec![false; base.vertex_count()];
     let offset = simplify::restore_volume(&mut base, surface, used, volume, &still);

@@ -135,6 +135,103 @@ pub struct SimplifyStats {
     pub seconds: f64,
 }
 
+/// How the mesh was simplified, and how far it lies from the exact surface.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Simplified {
+    /// What simplification did.
+    #[serde(flatten)]
+    pub stats: SimplifyStats,
+    /// The largest distance from points sampled on the written mesh (a quarter voxel apart) to
+    /// the exact surface, mm.
+    pub deviation: f64,
+    /// The voxel the simplified mesh was made on, mm: finer than the part's where its uniform
+    /// mesh strayed further than the tolerance.
+    pub voxel: f64,
+    /// The largest deviation of the uniform mesh on the part's voxels, mm.
+    pub uniform_deviation: f64,
+    /// Triangles of the uniform mesh on the part's voxels.
+    pub uniform_triangles: u64,
+}
+
+/// A mesh simplified by [`within`].
+pub struct Within {
+    /// The simplified mesh.
+    pub mesh: Mesh,
+    /// What simplification did.
+    pub stats: SimplifyStats,
+    /// Its measured deviation from the surface ([`deviation`], a quarter voxel apart), mm.
+    pub deviation: f64,
+    /// Whether that deviation is within the bound asked.
+    pub kept: bool,
+}
+
+/// Simplifies `mesh` (made on `voxel` mm) within `tolerance` of `surface`, its volume restored
+/// to `volume`, and measures the result's deviation four times finer than each collapse is
+/// checked; where that exceeds `bound` (the tolerance, or the uniform mesh's own deviation where
+/// that is larger), simplified again at ¾ of the aim, three tries at most. The last try is
+/// returned when none kept within `bound`.
+pub fn within(
+    mesh: &Mesh,
+    surface: Surface<'_>,
+    voxel: f64,
+    tolerance: f64,
+    bound: f64,
+    volume: Option<f64>,
+) -> Within {
+    let mut aim = tolerance;
+    let mut tries = 0;
+    loop {
+        tries += 1;
+        let settings = Settings {
+            tolerance: aim,
+            voxel,
+        };
+        let (out, stats) = simplify(mesh, surface, settings, volume);
+        let deviation = self::deviation(&out, surface, 0.25 * voxel);
+        let kept = deviation <= bound;
+        if kept || tries == 3 {
+            return Within {
+                mesh: out,
+                stats: SimplifyStats { tolerance, ..stats },
+                deviation,
+                kept,
+            };
+        }
+        aim *= 0.75;
+    }
+}
+
+/// A finished mesh (made on `voxel` mm) simplified within `tolerance` of the `surface` it
+/// stands for, its volume kept: for meshes that are written as they are made (no finer
+/// remeshing, no fallback to the uniform mesh), such as a repair's remesh, a scan's part or a
+/// density field's solid.
+pub fn mesh_within(
+    mesh: &Mesh,
+    surface: Surface<'_>,
+    voxel: f64,
+    tolerance: f64,
+) -> (Mesh, Simplified) {
+    let uniform = deviation(mesh, surface, 0.25 * voxel);
+    let w = within(
+        mesh,
+        surface,
+        voxel,
+        tolerance,
+        tolerance.max(uniform),
+        Some(mesh.volume()),
+    );
+    (
+        w.mesh,
+        Simplified {
+            stats: w.stats,
+            deviation: w.deviation,
+            voxel,
+            uniform_deviation: uniform,
+            uniform_triangles: mesh.triangle_count() as u64,
+        },
+    )
+}
+
 /// Simplifies `mesh` (closed, manifold, outward) within `settings.tolerance` of `surface`;
 /// with `volume`, the result is offset along the surface's normal to enclose that volume
 /// ([`restore_volume`]).

@@ -477,15 +477,16 @@ fn fold_caps(mesh: &mut Mesh, bad: &check::FacetDefects) -> u64 {
     folded
 }
 
-/// `mesh` (a remesh on `voxel` mm) simplified within `tolerance` of `surface`'s triangles
-/// (their winding-signed distance), its volume kept, and how far it lies from them.
-fn simplify_remesh(
+/// `mesh` (made on `voxel` mm: a remesh, or any part meshed from a grid) simplified within
+/// `tolerance` of `surface`'s triangles (their winding-signed distance, so `surface` may be
+/// open or a soup), its volume kept, and how far it lies from them.
+pub fn simplify_to_mesh(
     mesh: &Mesh,
     surface: &Mesh,
     voxel: f64,
     tolerance: f64,
-) -> (Mesh, crate::mesh::pipeline::Simplified) {
-    use crate::mesh::simplify::{self, Settings, Surface};
+) -> (Mesh, crate::mesh::simplify::Simplified) {
+    use crate::mesh::simplify::{self, Surface};
     let bounds = surface
         .bounds()
         .into_iter()
@@ -503,35 +504,7 @@ fn simplify_remesh(
         field: &field,
         clip,
     };
-    let uniform = simplify::deviation(mesh, surface, 0.25 * voxel);
-    // Where the measured deviation (sampled four times finer than each collapse is checked)
-    // exceeds the tolerance, simplified again at a smaller one, as a part is.
-    let (mut aim, mut best) = (tolerance, None);
-    for _ in 0..3 {
-        let settings = Settings {
-            tolerance: aim,
-            voxel,
-        };
-        let (out, stats) = simplify::simplify(mesh, surface, settings, Some(mesh.volume()));
-        let deviation = simplify::deviation(&out, surface, 0.25 * voxel);
-        let done = deviation <= tolerance.max(uniform);
-        best = Some((out, stats, deviation));
-        if done {
-            break;
-        }
-        aim *= 0.75;
-    }
-    let (out, stats, deviation) = best.expect("simplified once at least");
-    (
-        out,
-        crate::mesh::pipeline::Simplified {
-            stats: simplify::SimplifyStats { tolerance, ..stats },
-            deviation,
-            voxel,
-            uniform_deviation: uniform,
-            uniform_triangles: mesh.triangle_count() as u64,
-        },
-    )
+    simplify::mesh_within(mesh, surface, voxel, tolerance)
 }
 
 /// Repairs `mesh`. Returns the repaired mesh and what was done.
@@ -669,7 +642,7 @@ pub fn repair(
     let simplified = match (opts.tolerance, before_remesh, remesh_voxel) {
         (Some(tolerance), Some(surface), Some(voxel)) if remeshed => {
             let _s = progress.stage("simplifying the remesh");
-            let (m, s) = simplify_remesh(&w.mesh, &surface, voxel, tolerance);
+            let (m, s) = simplify_to_mesh(&w.mesh, &surface, voxel, tolerance);
             w.mesh = m;
             w.topo = None;
             Some(s)

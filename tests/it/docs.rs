@@ -149,6 +149,52 @@ fn outputs(command: &str) -> Vec<String> {
     out
 }
 
+/// The words of `command` that name files: not options, with an extension.
+fn file_words(command: &str) -> Vec<String> {
+    let command = command.split(" #").next().unwrap_or(command);
+    command
+        .split_whitespace()
+        .flat_map(|w| w.split(['=', ',', ':']))
+        .map(|w| w.trim_matches(['"', '\'']))
+        .filter(|w| {
+            !w.starts_with('-')
+                && w.rsplit_once('.').is_some_and(|(a, e)| {
+                    !a.is_empty() && e.chars().any(|c| c.is_ascii_alphabetic())
+                })
+        })
+        .map(str::to_string)
+        .collect()
+}
+
+/// The steps the long examples need: the files, the long examples, and every earlier example
+/// that names a file a later needed one names (an input it makes), unless the file is one of
+/// `examples`' own (which every page starts with). Every command runs in its folder, so an
+/// example that makes a later one's input without naming it is not expected.
+fn needed_by_long(steps: Vec<Step>, examples: &Path) -> Vec<Step> {
+    let mut wanted: std::collections::HashSet<String> = std::collections::HashSet::new();
+    let mut keep = vec![false; steps.len()];
+    for (i, s) in steps.iter().enumerate().rev() {
+        match s {
+            Step::File { .. } => keep[i] = true,
+            Step::Run { command, long, .. } => {
+                let words = file_words(command);
+                let makes = words
+                    .iter()
+                    .any(|w| wanted.contains(w) && !examples.join(w).exists());
+                if *long || makes {
+                    keep[i] = true;
+                    wanted.extend(words);
+                }
+            }
+        }
+    }
+    steps
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(s, k)| k.then_some(s))
+        .collect()
+}
+
 fn copy_dir(from: &Path, to: &Path) {
     let Ok(entries) = std::fs::read_dir(from) else {
         return;
@@ -178,16 +224,16 @@ fn run_page(page: &Path, long: bool) -> (usize, Vec<String>) {
     if !steps.iter().any(|s| matches!(s, Step::Run { .. })) {
         return (0, Vec::new());
     }
-    // The long tier runs the pages that have long examples, up to the last of them (with the
-    // examples before them, which may make their inputs); the main tier has run the rest.
+    // The long tier runs the pages that have long examples: those examples, and the earlier
+    // ones that make their inputs; the main tier has run the rest.
     if long {
-        match steps
+        if !steps
             .iter()
-            .rposition(|s| matches!(s, Step::Run { long: true, .. }))
+            .any(|s| matches!(s, Step::Run { long: true, .. }))
         {
-            Some(last) => steps.truncate(last + 1),
-            None => return (0, Vec::new()),
+            return (0, Vec::new());
         }
+        steps = needed_by_long(steps, &root().join("docs/examples"));
     }
     let dir = tempdir();
     copy_dir(&root().join("docs/examples"), dir.path());
@@ -321,6 +367,24 @@ fn the_conventions_read_pages_as_written() {
     assert_eq!(
         outputs("latvox tpms --type d  -o d.stl --report=d.json"),
         ["d.stl", "d.json"]
+    );
+    // The long tier keeps the long examples and what makes their inputs.
+    let page = "```bash\nlatvox topopt -o c.npy\nlatvox tpms --type d -o d.stl\n\
+                latvox check broken.stl  # exit 1\n```\n\n<!-- example: long -->\n```bash\n\
+                latvox interpret c.npy --images=s -o c.stl\n```\n";
+    let kept: Vec<String> = needed_by_long(steps("page.md", page), &root().join("docs/examples"))
+        .into_iter()
+        .map(|s| match s {
+            Step::Run { command, .. } => command,
+            Step::File { name, .. } => name,
+        })
+        .collect();
+    assert_eq!(
+        kept,
+        [
+            "latvox topopt -o c.npy",
+            "latvox interpret c.npy --images=s -o c.stl"
+        ]
     );
     let wrong = std::panic::catch_unwind(|| steps("p.md", "```sh\nlatvox tpms -o a.stl\n```\n"));
     assert!(wrong.is_err(), "a latvox line in a sh block is refused");

@@ -133,6 +133,7 @@ fn skin_job(points: Vec<[f64; 3]>, voxel: f64) -> FgmJob {
         composition: Composition::new(vec!["A".into(), "B".into()], vec![Law::Power { p: 1.0 }])
             .unwrap(),
         dmax: None,
+        tolerance: None,
         verify: latvox::verify::Verify::Full,
     }
 }
@@ -660,6 +661,93 @@ fn meshes_carry_the_composition() {
         assert!(
             (r - 255.0 * f).abs() <= 1.0 && (b - 255.0 * (1.0 - f)).abs() <= 1.0,
             "{p:?}: {c} vs {f}"
+        );
+    }
+}
+
+/// The largest `|distance|` over points sampled on `tris` (corners and a barycentric grid).
+fn worst_distance(tris: &[common::Tri], distance: &dyn Fn([f64; 3]) -> f64) -> f64 {
+    let n = 6;
+    let mut worst: f64 = 0.0;
+    for t in tris {
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                let w = 1.0 - u - v;
+                let p = [0, 1, 2].map(|k| u * t[0][k] + v * t[1][k] + w * t[2][k]);
+                worst = worst.max(distance(p).abs());
+            }
+        }
+    }
+    worst
+}
+
+/// `--tolerance`: the part's mesh simplified within it of the part's surface, for a torus given
+/// as a fine mesh (within 0.003 mm of the analytic torus) and for a sphere's scan (where the
+/// surface is the one meshed from the scan's distance). Checked by the test: closed, one piece,
+/// free of self-intersections (its own search, and CGAL's verdict), the uniform mesh's volume,
+/// every sampled point within the tolerance of the analytic surface (plus the uniform mesh's
+/// own deviation, for the scan), and at least 5× fewer triangles.
+#[test]
+fn meshes_simplified_within_a_tolerance_stay_on_the_surface() {
+    let dir = tempdir();
+    let d = dir.path();
+    crate::meshkit::write_stl(
+        &d.join("torus.stl"),
+        &crate::meshkit::torus(10.0, 4.0, 256, 128),
+    );
+    write_xyz(&d.join("s.xyz"), &Shape::Sphere.scan(20_000, 0.0, false, 4));
+    let torus = |p: [f64; 3]| {
+        let ring = (p[0] * p[0] + p[1] * p[1]).sqrt() - 10.0;
+        (ring * ring + p[2] * p[2]).sqrt() - 4.0
+    };
+    let sphere = |p: [f64; 3]| Shape::Sphere.distance(p);
+    type Distance<'a> = &'a dyn Fn([f64; 3]) -> f64;
+    let cases: [(&str, &str, Distance, &str, f64); 2] = [
+        ("--mesh", "torus.stl", &torus, "0.25", 0.1),
+        ("--points", "s.xyz", &sphere, "0.4", 0.15),
+    ];
+    for (flag, input, distance, voxel, tolerance) in cases {
+        let tol = tolerance.to_string();
+        let base = ["fgm", flag, input, "--voxel", voxel, "-q"];
+        ok(&[&base[..], &["-o", "uniform.stl"]].concat(), d);
+        let args = [
+            &base[..],
+            &["--tolerance", &tol, "--verify", "cgal"],
+            &["-o", "simple.stl", "--report", "r.json"],
+        ]
+        .concat();
+        ok(&args, d);
+        let (u, s) = (
+            common::read_stl(&d.join("uniform.stl")),
+            common::read_stl(&d.join("simple.stl")),
+        );
+        let r = json(&d.join("r.json"));
+        assert_eq!(r["checks"]["checked_by"], "CGAL", "{input}");
+        assert_eq!(r["checks"]["self_intersecting"], false, "{input}");
+        assert_eq!(common::edges(&s), common::Edges::default(), "{input}");
+        assert_eq!(common::pieces(&s), 1, "{input}");
+        assert_eq!(crate::meshkit::intersecting_pairs(&s), 0, "{input}");
+        let (vu, vs) = (common::volume(&u), common::volume(&s));
+        assert!((vs / vu - 1.0).abs() < 2e-3, "{input}: {vs} vs {vu} mm³");
+        let (du, ds) = (worst_distance(&u, distance), worst_distance(&s, distance));
+        let bound = match flag {
+            "--mesh" => tolerance.max(du) + 0.003,
+            _ => tolerance + du,
+        };
+        let ratio = u.len() as f64 / s.len() as f64;
+        eprintln!(
+            "{input}: {} → {} triangles ({ratio:.1}×), deviation {du:.4} → {ds:.4} mm (bound {bound:.4})",
+            u.len(),
+            s.len()
+        );
+        assert!(ds <= bound, "{input}: deviation {ds} > {bound}");
+        assert!(ratio >= 5.0, "{input}: {ratio:.1}× fewer");
+        let reported = &r["simplified"];
+        assert_eq!(reported["uniform_triangles"], u.len(), "{input}");
+        assert!(
+            reported["deviation"].as_f64().unwrap() <= tolerance.max(du) + 0.003,
+            "{input}: {reported:#}"
         );
     }
 }
