@@ -533,6 +533,7 @@ def fgm(
     two_d: bool = False,
     mesh: Optional[Value] = None,
     voxel: Optional[Value] = None,
+    tolerance: Optional[Value] = None,
     sign: Optional[Value] = None,
     feature: Optional[Union[Value, List[Value]]] = None,
     weights: Optional[Value] = None,
@@ -565,6 +566,10 @@ def fgm(
     2d: The points are a closed contour in a plane (x y per line): a signed distance image
     mesh: The part as a closed mesh (.stl, .obj, .off, .ply, .3mf)
     voxel: Voxel edge, mm (default: the part's longest side / 128)
+    tolerance: Simplify the part's mesh within this distance of its surface, mm (of the input mesh
+        with --mesh; of the surface meshed from a scan's distance field): large triangles where it
+        is flat, the volume kept, the deviation measured and reported. Default: the uniform mesh,
+        two triangles per voxel the surface crosses
     sign: How a scan's inside is told from its outside away from the points (default: winding)
         [winding, scan]
     feature: A feature the composition is graded from: point:X,Y,Z, curve:FILE.csv (a polyline),
@@ -632,7 +637,11 @@ def interpret(
     filter_radius: Density filter radius, in elements (default: 1)
     max_iterations: Bound on the repair loop's passes (default: 30)
     thickness: Extrusion of a 2D field, mm (default: one element)
-    tolerance: Max deviation of the CAD curves from the boundary, mm (default: half a refined pixel)
+    tolerance: 2D: the largest deviation of the CAD curves from the boundary, mm (default: half a
+        refined pixel). 3D: simplify the mesh within this distance of the density's iso-surface (of
+        the smoothed surface with --smooth): large triangles where it is flat, the volume kept, the
+        deviation measured and reported (default: the uniform mesh, two triangles per voxel the
+        surface crosses)
     output: Output, in the format its extension names: a mesh (.stl, .obj, .off, .ply, .3mf) or the
         part's level set (.vdb, OpenVDB, a grid named sdf) (default: part.stl)
     ascii: Write ASCII STL (or ASCII PLY)
