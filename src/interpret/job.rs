@@ -207,7 +207,8 @@ pub fn run(d: &Density, job: &InterpretJob, progress: &Progress) -> Result<Inter
         mesh_solid(d, job, &mut cleaned)?
     };
     let (mesh, simplified) = match job.mesh_tolerance {
-        Some(tolerance) if d.is_3d => {
+        // Set for 3D fields only.
+        Some(tolerance) => {
             let _s = progress.stage("simplifying");
             let (m, s) = if job.smooth_iterations > 0 {
                 // The smoothed surface exists only as its grid: held to its uniform mesh.
@@ -217,7 +218,7 @@ pub fn run(d: &Density, job: &InterpretJob, progress: &Progress) -> Result<Inter
             };
             (m, Some(s))
         }
-        _ => (mesh, None),
+        None => (mesh, None),
     };
     timings.mesh = t.elapsed().as_secs_f64();
     let t = Instant::now();

@@ -665,23 +665,6 @@ fn meshes_carry_the_composition() {
     }
 }
 
-/// The largest `|distance|` over points sampled on `tris` (corners and a barycentric grid).
-fn worst_distance(tris: &[common::Tri], distance: &dyn Fn([f64; 3]) -> f64) -> f64 {
-    let n = 6;
-    let mut worst: f64 = 0.0;
-    for t in tris {
-        for i in 0..=n {
-            for j in 0..=n - i {
-                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
-                let w = 1.0 - u - v;
-                let p = [0, 1, 2].map(|k| u * t[0][k] + v * t[1][k] + w * t[2][k]);
-                worst = worst.max(distance(p).abs());
-            }
-        }
-    }
-    worst
-}
-
 /// `--tolerance`: the part's mesh simplified within it of the part's surface, for a torus given
 /// as a fine mesh (within 0.003 mm of the analytic torus) and for a sphere's scan (where the
 /// surface is the one meshed from the scan's distance). Checked by the test: closed, one piece,
@@ -730,7 +713,8 @@ fn meshes_simplified_within_a_tolerance_stay_on_the_surface() {
         assert_eq!(crate::meshkit::intersecting_pairs(&s), 0, "{input}");
         let (vu, vs) = (common::volume(&u), common::volume(&s));
         assert!((vs / vu - 1.0).abs() < 2e-3, "{input}: {vs} vs {vu} mm³");
-        let (du, ds) = (worst_distance(&u, distance), worst_distance(&s, distance));
+        let worst = |tris: &[common::Tri]| common::worst_on(tris, |p| distance(p).abs());
+        let (du, ds) = (worst(&u), worst(&s));
         let bound = match flag {
             "--mesh" => tolerance.max(du) + 0.003,
             _ => tolerance + du,

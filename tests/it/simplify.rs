@@ -6,7 +6,7 @@ use crate::common::*;
 use crate::meshkit;
 use std::path::Path;
 
-/// The largest distance from points sampled on `tris` (a barycentric grid of `n` steps) to the
+/// The largest distance from points sampled on `tris` ([`worst_on`]'s barycentric grid) to the
 /// surface of the TPMS part in `bounds`: the level set `F = t` (a net) or `|F| = t` (a sheet),
 /// to first order `|F − t| / |∇F|`, or the box's face where that is nearer (the part is cut by
 /// its box).
@@ -18,30 +18,20 @@ fn deviation(
     cell: f64,
     bounds: ([f64; 3], [f64; 3]),
 ) -> f64 {
-    let n = 6;
-    let mut worst: f64 = 0.0;
-    for tri in tris {
-        for i in 0..=n {
-            for j in 0..=n - i {
-                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
-                let w = 1.0 - u - v;
-                let p = [0, 1, 2].map(|k| u * tri[0][k] + v * tri[1][k] + w * tri[2][k]);
-                let local = [0, 1, 2].map(|k| p[k] - bounds.0[k]);
-                let (f, g) = tpms(ty, local, cell);
-                let gl = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-                let surface = if sheet {
-                    (f.abs() - t).abs() / gl
-                } else {
-                    (f - t).abs() / gl
-                };
-                let face = (0..3)
-                    .map(|k| (p[k] - bounds.0[k]).min(bounds.1[k] - p[k]))
-                    .fold(f64::INFINITY, f64::min);
-                worst = worst.max(surface.min(face.max(0.0)));
-            }
-        }
-    }
-    worst
+    worst_on(tris, |p| {
+        let local = [0, 1, 2].map(|k| p[k] - bounds.0[k]);
+        let (f, g) = tpms(ty, local, cell);
+        let gl = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+        let surface = if sheet {
+            (f.abs() - t).abs() / gl
+        } else {
+            (f - t).abs() / gl
+        };
+        let face = (0..3)
+            .map(|k| (p[k] - bounds.0[k]).min(bounds.1[k] - p[k]))
+            .fold(f64::INFINITY, f64::min);
+        surface.min(face.max(0.0))
+    })
 }
 
 /// Makes a TPMS part with `args` (a uniform one beside it) and checks the simplified one:

@@ -185,6 +185,24 @@ pub fn bounds(tris: &[Tri]) -> ([f64; 3], [f64; 3]) {
     (lo, hi)
 }
 
+/// The largest `f` over points sampled on `tris`: a barycentric grid of 6 steps a side
+/// (corners, edges and inside).
+pub fn worst_on(tris: &[Tri], f: impl Fn([f64; 3]) -> f64) -> f64 {
+    let n = 6;
+    let mut worst: f64 = 0.0;
+    for t in tris {
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                let w = 1.0 - u - v;
+                let p = [0, 1, 2].map(|k| u * t[0][k] + v * t[1][k] + w * t[2][k]);
+                worst = worst.max(f(p));
+            }
+        }
+    }
+    worst
+}
+
 /// The seed's formulas, with X = 2πx / a; returns F and its gradient in mm⁻¹.
 pub fn tpms(name: &str, p: [f64; 3], a: f64) -> (f64, [f64; 3]) {
     let w = 2.0 * std::f64::consts::PI / a;
