@@ -160,14 +160,15 @@ def tpms(
         thin for the voxels
     adaptivity: Kept for older scripts: simplify within this many voxels, 0 to 1 (0.5: half a
         voxel); --tolerance says it in millimetres and wins over it (default: 0)
-    tolerance: Simplify the mesh: the largest distance allowed between it and the exact surface, mm.
-        Flat regions get large triangles, curved ones small; every vertex stays on the surface, the
-        density is kept, and the deviation is measured and reported. Without it the mesh is uniform
-        (two triangles per voxel the surface crosses): its deviation is about half a voxel at the
-        box's cut edges and where struts meet, so half a voxel (cell / resolution / 2, 0.078 mm for
-        5 mm cells at 32) keeps that deviation with 10–30× fewer triangles. A smaller one meshes the
-        part on voxels up to half as large first. The part is then meshed whole (not copied cell by
-        cell, nor in tiles)
+    tolerance: Simplify the mesh: the largest distance allowed between it and the exact surface, mm,
+        or auto. Flat regions get large triangles, curved ones small; every vertex stays on the
+        surface, the density is kept, and the deviation is measured and reported. Without it the
+        mesh is uniform (two triangles per voxel the surface crosses): its deviation is about half a
+        voxel at the box's cut edges and where struts meet. auto keeps to that: half a voxel (cell /
+        resolution / 2, 0.078 mm for 5 mm cells at 32), or the deviation measured on the uniform
+        mesh where larger, with 7–30× fewer triangles. A tolerance under the uniform mesh's
+        deviation meshes the part on voxels up to half as large first. The part is then meshed whole
+        (not copied cell by cell, nor in tiles)
     output: Output mesh, in the format its extension names: .stl (binary, ASCII with --ascii) or
         .3mf, streamed to the file as it is made; .obj, .off or .ply (binary, ASCII with --ascii),
         written once the part is whole; .vdb, the part's level set at its voxels (OpenVDB, a grid
@@ -261,14 +262,15 @@ def strut(
         thin for the voxels
     adaptivity: Kept for older scripts: simplify within this many voxels, 0 to 1 (0.5: half a
         voxel); --tolerance says it in millimetres and wins over it (default: 0)
-    tolerance: Simplify the mesh: the largest distance allowed between it and the exact surface, mm.
-        Flat regions get large triangles, curved ones small; every vertex stays on the surface, the
-        density is kept, and the deviation is measured and reported. Without it the mesh is uniform
-        (two triangles per voxel the surface crosses): its deviation is about half a voxel at the
-        box's cut edges and where struts meet, so half a voxel (cell / resolution / 2, 0.078 mm for
-        5 mm cells at 32) keeps that deviation with 10–30× fewer triangles. A smaller one meshes the
-        part on voxels up to half as large first. The part is then meshed whole (not copied cell by
-        cell, nor in tiles)
+    tolerance: Simplify the mesh: the largest distance allowed between it and the exact surface, mm,
+        or auto. Flat regions get large triangles, curved ones small; every vertex stays on the
+        surface, the density is kept, and the deviation is measured and reported. Without it the
+        mesh is uniform (two triangles per voxel the surface crosses): its deviation is about half a
+        voxel at the box's cut edges and where struts meet. auto keeps to that: half a voxel (cell /
+        resolution / 2, 0.078 mm for 5 mm cells at 32), or the deviation measured on the uniform
+        mesh where larger, with 7–30× fewer triangles. A tolerance under the uniform mesh's
+        deviation meshes the part on voxels up to half as large first. The part is then meshed whole
+        (not copied cell by cell, nor in tiles)
     output: Output mesh, in the format its extension names: .stl (binary, ASCII with --ascii) or
         .3mf, streamed to the file as it is made; .obj, .off or .ply (binary, ASCII with --ascii),
         written once the part is whole; .vdb, the part's level set at its voxels (OpenVDB, a grid
@@ -382,14 +384,15 @@ def voronoi(
         thin for the voxels
     adaptivity: Kept for older scripts: simplify within this many voxels, 0 to 1 (0.5: half a
         voxel); --tolerance says it in millimetres and wins over it (default: 0)
-    tolerance: Simplify the mesh: the largest distance allowed between it and the exact surface, mm.
-        Flat regions get large triangles, curved ones small; every vertex stays on the surface, the
-        density is kept, and the deviation is measured and reported. Without it the mesh is uniform
-        (two triangles per voxel the surface crosses): its deviation is about half a voxel at the
-        box's cut edges and where struts meet, so half a voxel (cell / resolution / 2, 0.078 mm for
-        5 mm cells at 32) keeps that deviation with 10–30× fewer triangles. A smaller one meshes the
-        part on voxels up to half as large first. The part is then meshed whole (not copied cell by
-        cell, nor in tiles)
+    tolerance: Simplify the mesh: the largest distance allowed between it and the exact surface, mm,
+        or auto. Flat regions get large triangles, curved ones small; every vertex stays on the
+        surface, the density is kept, and the deviation is measured and reported. Without it the
+        mesh is uniform (two triangles per voxel the surface crosses): its deviation is about half a
+        voxel at the box's cut edges and where struts meet. auto keeps to that: half a voxel (cell /
+        resolution / 2, 0.078 mm for 5 mm cells at 32), or the deviation measured on the uniform
+        mesh where larger, with 7–30× fewer triangles. A tolerance under the uniform mesh's
+        deviation meshes the part on voxels up to half as large first. The part is then meshed whole
+        (not copied cell by cell, nor in tiles)
     output: Output mesh, in the format its extension names: .stl (binary, ASCII with --ascii) or
         .3mf, streamed to the file as it is made; .obj, .off or .ply (binary, ASCII with --ascii),
         written once the part is whole; .vdb, the part's level set at its voxels (OpenVDB, a grid
@@ -494,14 +497,15 @@ def fill(
         thin for the voxels
     adaptivity: Kept for older scripts: simplify within this many voxels, 0 to 1 (0.5: half a
         voxel); --tolerance says it in millimetres and wins over it (default: 0)
-    tolerance: Simplify the mesh: the largest distance allowed between it and the exact surface, mm.
-        Flat regions get large triangles, curved ones small; every vertex stays on the surface, the
-        density is kept, and the deviation is measured and reported. Without it the mesh is uniform
-        (two triangles per voxel the surface crosses): its deviation is about half a voxel at the
-        box's cut edges and where struts meet, so half a voxel (cell / resolution / 2, 0.078 mm for
-        5 mm cells at 32) keeps that deviation with 10–30× fewer triangles. A smaller one meshes the
-        part on voxels up to half as large first. The part is then meshed whole (not copied cell by
-        cell, nor in tiles)
+    tolerance: Simplify the mesh: the largest distance allowed between it and the exact surface, mm,
+        or auto. Flat regions get large triangles, curved ones small; every vertex stays on the
+        surface, the density is kept, and the deviation is measured and reported. Without it the
+        mesh is uniform (two triangles per voxel the surface crosses): its deviation is about half a
+        voxel at the box's cut edges and where struts meet. auto keeps to that: half a voxel (cell /
+        resolution / 2, 0.078 mm for 5 mm cells at 32), or the deviation measured on the uniform
+        mesh where larger, with 7–30× fewer triangles. A tolerance under the uniform mesh's
+        deviation meshes the part on voxels up to half as large first. The part is then meshed whole
+        (not copied cell by cell, nor in tiles)
     output: Output mesh, in the format its extension names: .stl (binary, ASCII with --ascii) or
         .3mf, streamed to the file as it is made; .obj, .off or .ply (binary, ASCII with --ascii),
         written once the part is whole; .vdb, the part's level set at its voxels (OpenVDB, a grid

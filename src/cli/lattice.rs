@@ -3,8 +3,8 @@
 
 use super::out::outln;
 use super::{
-    cgal_findings, parse_counts, parse_finite3, parse_positive, parse_positive3, parse_size,
-    parse_tile, parse_unit, write_json,
+    cgal_findings, parse_counts, parse_finite3, parse_positive3, parse_size, parse_tile,
+    parse_unit, write_json,
 };
 use clap::Args;
 use latvox::field::density::DensityField;
@@ -12,7 +12,7 @@ use latvox::field::Domain;
 use latvox::io::sink::MeshSink;
 use latvox::mesh::graded::{Grading, GradingReport};
 use latvox::mesh::output::MeshFile;
-use latvox::mesh::pipeline::Options;
+use latvox::mesh::pipeline::{Options, Tolerance};
 use latvox::mesh::report::PartReport;
 use latvox::verify::Verify;
 use latvox::{Error, Result};
@@ -203,16 +203,17 @@ pub struct MeshArgs {
     /// --tolerance says it in millimetres and wins over it.
     #[arg(long, default_value_t = 0.0, value_parser = parse_unit)]
     pub adaptivity: f64,
-    /// Simplify the mesh: the largest distance allowed between it and the exact surface, mm.
-    /// Flat regions get large triangles, curved ones small; every vertex stays on the surface,
-    /// the density is kept, and the deviation is measured and reported. Without it the mesh is
-    /// uniform (two triangles per voxel the surface crosses): its deviation is about half a
-    /// voxel at the box's cut edges and where struts meet, so half a voxel
-    /// (cell / resolution / 2, 0.078 mm for 5 mm cells at 32) keeps that deviation with 10–30×
-    /// fewer triangles. A smaller one meshes the part on voxels up to half as large first. The part is then
-    /// meshed whole (not copied cell by cell, nor in tiles).
-    #[arg(long, value_name = "MM", value_parser = parse_positive, allow_hyphen_values = true)]
-    pub tolerance: Option<f64>,
+    /// Simplify the mesh: the largest distance allowed between it and the exact surface, mm, or
+    /// auto. Flat regions get large triangles, curved ones small; every vertex stays on the
+    /// surface, the density is kept, and the deviation is measured and reported. Without it
+    /// the mesh is uniform (two triangles per voxel the surface crosses): its deviation is
+    /// about half a voxel at the box's cut edges and where struts meet. auto keeps to that:
+    /// half a voxel (cell / resolution / 2, 0.078 mm for 5 mm cells at 32), or the deviation
+    /// measured on the uniform mesh where larger, with 7–30× fewer triangles. A tolerance under
+    /// the uniform mesh's deviation meshes the part on voxels up to half as large first. The
+    /// part is then meshed whole (not copied cell by cell, nor in tiles).
+    #[arg(long, value_name = "MM|auto", value_parser = Tolerance::parse, allow_hyphen_values = true)]
+    pub tolerance: Option<Tolerance>,
     /// Output mesh, in the format its extension names: .stl (binary, ASCII with --ascii) or
     /// .3mf, streamed to the file as it is made; .obj, .off or .ply (binary, ASCII with
     /// --ascii), written once the part is whole; .vdb, the part's level set at its voxels
@@ -386,14 +387,18 @@ pub(crate) fn print_part(r: &PartReport) {
     if let Some(s) = &r.simplified {
         let st = &s.stats;
         outln!(
-            "simplified {} of the uniform mesh's {} triangles ({:.1}× fewer); deviation {:.4} mm measured, tolerance {} mm{}",
+            "simplified {} of the uniform mesh's {} triangles ({:.1}× fewer); deviation {:.4} mm measured, tolerance {}{}",
             st.triangles_after,
             s.uniform_triangles,
             s.uniform_triangles as f64 / st.triangles_after.max(1) as f64,
             s.deviation,
-            st.tolerance,
+            if s.auto {
+                format!("{:.4} mm (auto)", st.tolerance)
+            } else {
+                format!("{} mm", st.tolerance)
+            },
             if st.gave_up {
-                " (crossings remained: the uniform mesh was written)".to_string()
+                " — not simplified within it: the uniform mesh was written".to_string()
             } else if s.voxel < r.meshing.voxel_size {
                 format!(" (meshed on {:.4} mm voxels first)", s.voxel)
             } else {
@@ -427,8 +432,19 @@ pub(crate) fn print_part(r: &PartReport) {
     );
     let t = &r.timings;
     outln!(
-        "time      {:.3} s (calibrate {:.3}, sample {:.3}, mesh {:.3}, snap {:.3}, verify {:.3}, write {:.3})",
-        t.total, t.calibrate, t.sample, t.mesh, t.snap, t.verify, t.write
+        "time      {:.3} s (calibrate {:.3}, sample {:.3}, mesh {:.3}, snap {:.3}{}, verify {:.3}, write {:.3})",
+        t.total,
+        t.calibrate,
+        t.sample,
+        t.mesh,
+        t.snap,
+        if r.simplified.is_some() {
+            format!(", simplify {:.3}", t.simplify)
+        } else {
+            String::new()
+        },
+        t.verify,
+        t.write
     );
     if let Some(o) = &r.output {
         outln!("wrote     {o}");

@@ -88,6 +88,9 @@ impl<T: Field + ?Sized> Field for &T {
     fn implicit_with_gradient(&self, p: Vec3) -> (f64, Vec3) {
         (**self).implicit_with_gradient(p)
     }
+    fn smooth_near(&self, p: Vec3, reach: f64) -> bool {
+        (**self).smooth_near(p, reach)
+    }
     fn sample_block(&self, origin: Vec3, h: f64, out: &mut [f32; 512]) {
         (**self).sample_block(origin, h, out)
     }

@@ -203,10 +203,10 @@ pub struct Options {
     /// tolerance of that many voxels ([`Options::tolerance_at`]): OpenVDB's adaptive meshes
     /// could cross themselves.
     pub adaptivity: f64,
-    /// Simplify the mesh within this distance of the exact surface, mm (see
+    /// Simplify the mesh within this distance of the exact surface (see
     /// [`crate::mesh::simplify`]); the part is then meshed whole and its density measured on
     /// the simplified mesh.
-    pub tolerance: Option<f64>,
+    pub tolerance: Option<Tolerance>,
     /// How the written part is verified.
     pub verify: Verify,
     /// Copy a periodic part's cells from a meshed template where possible.
@@ -222,9 +222,33 @@ pub struct Options {
 impl Options {
     /// The tolerance the mesh is simplified within on voxels of `voxel` mm: the one asked, or
     /// `adaptivity` voxels.
-    pub fn tolerance_at(&self, voxel: f64) -> Option<f64> {
+    pub fn tolerance_at(&self, voxel: f64) -> Option<Tolerance> {
         self.tolerance
-            .or((self.adaptivity > 0.0).then_some(self.adaptivity * voxel))
+            .or((self.adaptivity > 0.0).then_some(Tolerance::Mm(self.adaptivity * voxel)))
+    }
+}
+
+/// How far a simplified mesh may stray from the exact surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tolerance {
+    /// At most this distance, mm.
+    Mm(f64),
+    /// The default mesh's deviation: half a voxel, or the deviation the uniform mesh on the
+    /// part's voxels measures where that is larger (where the box cuts the lattice at a graze,
+    /// where struts meet).
+    Auto,
+}
+
+impl Tolerance {
+    /// `auto` ([`Tolerance::Auto`]) or a positive length in mm.
+    pub fn parse(s: &str) -> std::result::Result<Tolerance, String> {
+        if s.trim() == "auto" {
+            return Ok(Tolerance::Auto);
+        }
+        match s.trim().parse::<f64>() {
+            Ok(v) if v > 0.0 && v.is_finite() => Ok(Tolerance::Mm(v)),
+            _ => Err(format!("{s} must be a positive length in mm, or auto")),
+        }
     }
 }
 
@@ -891,7 +915,11 @@ fn write_part<S: Solid>(
     };
     let (mesh, simplified) = {
         let _p = progress.stage("simplifying");
-        simplify_part(solid, mesh.into_mesh(), voxel, tolerance, o.keep_fragments)?
+        let t = Instant::now();
+        let (mesh, mut simplified) =
+            simplify_part(solid, mesh.into_mesh(), voxel, tolerance, o.keep_fragments)?;
+        simplified.stats.seconds = t.elapsed().as_secs_f64();
+        (mesh, simplified)
     };
     let mut w = write_whole(mesh, meshing, fragments, o, progress, sink)?;
     w.simplified = Some(simplified);
@@ -899,7 +927,8 @@ fn write_part<S: Solid>(
 }
 
 /// Simplifies the part's uniform `mesh` (made on `voxel`) within `tolerance` of `solid`'s exact
-/// surface. Where the uniform mesh itself strays further (it rounds the sharp edges where the
+/// surface ([`Tolerance::Auto`]: half a voxel or the uniform mesh's deviation, measured here). Where the
+/// uniform mesh itself strays further than a tolerance in mm (it rounds the sharp edges where the
 /// box cuts the lattice, or struts meet, by about half a voxel), the part is meshed again on
 /// voxels that much finer first (at most half as large). The result's volume is restored to the uniform
 /// mesh's, which the level search measured; its deviation is measured, and where it exceeds
@@ -909,7 +938,7 @@ fn simplify_part<S: Solid>(
     solid: &S,
     mesh: Mesh,
     voxel: f64,
-    tolerance: f64,
+    tolerance: Tolerance,
     keep_fragments: bool,
 ) -> Result<(Mesh, Simplified)> {
     let volume = mesh.volume();
@@ -922,50 +951,92 @@ fn simplify_part<S: Solid>(
         };
         simplify::deviation(m, surface, 0.25 * v)
     };
-    let (mut base, mut used) = (mesh, voxel);
-    let mut uniform = deviation_on(&base, used);
-    let requested_deviation = uniform;
-    if uniform > 0.9 * tolerance {
-        // At most half the voxel: four times the triangles to simplify.
-        let finer = used * (0.8 * tolerance / uniform).max(0.5);
-        let (mut keyed, _) = mesh_keyed(solid, part_spec(solid, finer), None, 0.0, None)?;
-        if !keep_fragments {
-            pieces::remove_fragments(&mut keyed);
+    let uniform = deviation_on(&mesh, voxel);
+    let auto = tolerance == Tolerance::Auto;
+    // The voxels to simplify on, in turn, and the tries on each: a tolerance in mm that the
+    // uniform mesh nearly reaches is met on voxels that much finer (at most half the voxel: four
+    // times the triangles to simplify); auto likewise where the uniform mesh's deviation sets it
+    // (the volume's offset pushes the worst of its valleys out), else on the part's voxels and,
+    // where no try keeps within it there, on voxels a little finer.
+    let (tolerance, voxels) = match tolerance {
+        Tolerance::Mm(t) if uniform > 0.9 * t => (
+            t,
+            vec![(voxel * (0.8 * t / uniform).max(0.5), simplify::TRIES)],
+        ),
+        Tolerance::Mm(t) => (t, vec![(voxel, simplify::TRIES)]),
+        Tolerance::Auto => {
+            let t = uniform.max(0.5 * voxel);
+            let finer = (0.8 * voxel, simplify::TRIES);
+            if uniform > 0.9 * t {
+                (t, vec![finer])
+            } else {
+                (t, vec![(voxel, simplify::TRIES), finer])
+            }
         }
-        base = keyed.into_mesh();
-        used = finer;
-        uniform = deviation_on(&base, used);
-    }
-    let field = solid.field(&part_spec(solid, used));
-    let surface = Surface {
-        field: &*field,
-        clip: solid.bounds(),
     };
-    // Where the uniform mesh strays further than asked even so, those triangles stay as they are
-    // and the rest is held to the tolerance.
-    let bound = tolerance.max(uniform);
-    let report = |stats: SimplifyStats, deviation: f64| Simplified {
+    let report = |stats: SimplifyStats, deviation: f64, used: f64| Simplified {
         stats: SimplifyStats { tolerance, ..stats },
         deviation,
         voxel: used,
-        uniform_deviation: requested_deviation,
+        uniform_deviation: uniform,
         uniform_triangles: requested_triangles,
+        auto,
     };
-    let w = simplify::within(&base, surface, used, tolerance, bound, Some(volume));
-    if w.kept {
-        return Ok((w.mesh, report(w.stats, w.deviation)));
+    let surface_on = |used: f64| solid.field(&part_spec(solid, used));
+    let mut finer: Option<(Mesh, f64)> = None;
+    for (used, tries) in voxels {
+        if used != voxel {
+            let (mut keyed, _) = mesh_keyed(solid, part_spec(solid, used), None, 0.0, None)?;
+            if !keep_fragments {
+                pieces::remove_fragments(&mut keyed);
+            }
+            finer = Some((keyed.into_mesh(), used));
+        }
+        let base = finer.as_ref().map_or(&mesh, |f| &f.0);
+        let field = surface_on(used);
+        let surface = Surface {
+            field: &*field,
+            clip: solid.bounds(),
+        };
+        // Where the uniform mesh strays further than asked even so, those triangles stay as
+        // they are and the rest is held to the tolerance (auto: the tolerance is that deviation
+        // on the part's voxels, a bound on finer ones too).
+        let bound = if auto || used == voxel {
+            tolerance.max(uniform)
+        } else {
+            tolerance.max(simplify::deviation(base, surface, 0.25 * used))
+        };
+        let w = simplify::within(base, surface, used, (tolerance, bound), Some(volume), tries);
+        if w.kept {
+            return Ok((w.mesh, report(w.stats, w.deviation, used)));
+        }
     }
-    let still = vec![false; base.vertex_count()];
-    let offset = simplify::restore_volume(&mut base, surface, used, volume, &still);
-    let stats = SimplifyStats {
-        triangles_before: base.triangle_count() as u64,
-        triangles_after: base.triangle_count() as u64,
+    // Not simplified within the tolerance: the uniform mesh, within its own deviation as it was
+    // (auto), or the finest one made, its volume restored.
+    let gave_up = |n: usize, offset: f64| SimplifyStats {
+        triangles_before: n as u64,
+        triangles_after: n as u64,
         offset,
         gave_up: true,
         ..Default::default()
     };
+    let (mut base, used) = match finer {
+        Some(f) if !auto => f,
+        _ => {
+            let n = mesh.triangle_count();
+            return Ok((mesh, report(gave_up(n, 0.0), uniform, voxel)));
+        }
+    };
+    let field = surface_on(used);
+    let surface = Surface {
+        field: &*field,
+        clip: solid.bounds(),
+    };
+    let still = vec![false; base.vertex_count()];
+    let offset = simplify::restore_volume(&mut base, surface, used, volume, &still);
     let deviation = simplify::deviation(&base, surface, 0.25 * used);
-    Ok((base, report(stats, deviation)))
+    let stats = gave_up(base.triangle_count(), offset);
+    Ok((base, report(stats, deviation, used)))
 }
 
 fn write_instanced(

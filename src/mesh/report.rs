@@ -25,6 +25,8 @@ pub struct Timings {
     pub mesh: f64,
     /// Snapping the vertices onto the surface and box.
     pub snap: f64,
+    /// Simplifying the mesh within a tolerance (meshing it on finer voxels first included).
+    pub simplify: f64,
     /// CGAL's checks.
     pub verify: f64,
     /// Writing the part.
@@ -184,6 +186,7 @@ impl PartReport {
                 sample: meshing.sample_seconds,
                 mesh: meshing.mesh_seconds,
                 snap: meshing.snap_seconds,
+                simplify: written.simplified.map_or(0.0, |s| s.stats.seconds),
                 verify: written.verify_seconds,
                 write: written.write_seconds,
                 ..timings

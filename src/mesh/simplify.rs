@@ -40,6 +40,9 @@ pub const MAX_NORMAL_DEGREES: f64 = 45.0;
 /// the triangle it replaces was already below it).
 pub const MIN_QUALITY: f64 = 0.1;
 
+/// Tries of [`within`] at most, each at ¾ of the previous one's aim.
+pub const TRIES: usize = 3;
+
 /// Rounds of simplification at most (each after the previous one's crossings were locked).
 pub const MAX_ROUNDS: usize = 4;
 
@@ -129,7 +132,8 @@ pub struct SimplifyStats {
     /// How far the vertices off the box's faces were moved along the surface's normal to
     /// restore the volume, mm (positive: outward).
     pub offset: f64,
-    /// Whether the input was returned unsimplified (crossings remained after every round).
+    /// Whether the input was returned unsimplified (crossings remained after every round, or
+    /// no try kept within the bound).
     pub gave_up: bool,
     /// Seconds spent.
     pub seconds: f64,
@@ -151,6 +155,9 @@ pub struct Simplified {
     pub uniform_deviation: f64,
     /// Triangles of the uniform mesh on the part's voxels.
     pub uniform_triangles: u64,
+    /// Whether the tolerance was the default mesh's deviation (`--tolerance auto`: half a voxel,
+    /// or the uniform mesh's deviation where larger).
+    pub auto: bool,
 }
 
 /// A mesh simplified by [`within`].
@@ -168,16 +175,17 @@ pub struct Within {
 /// Simplifies `mesh` (made on `voxel` mm) within `tolerance` of `surface`, its volume restored
 /// to `volume`, and measures the result's deviation four times finer than each collapse is
 /// checked; where that exceeds `bound` (the tolerance, or the uniform mesh's own deviation where
-/// that is larger), simplified again at ¾ of the aim, three tries at most. The last try is
+/// that is larger), simplified again at ¾ of the aim, `tries` at most. The last try is
 /// returned when none kept within `bound`.
 pub fn within(
     mesh: &Mesh,
     surface: Surface<'_>,
     voxel: f64,
-    tolerance: f64,
-    bound: f64,
+    (tolerance, bound): (f64, f64),
     volume: Option<f64>,
+    most: usize,
 ) -> Within {
+    let start = std::time::Instant::now();
     let mut aim = tolerance;
     let mut tries = 0;
     loop {
@@ -189,10 +197,14 @@ pub fn within(
         let (out, stats) = simplify(mesh, surface, settings, volume);
         let deviation = self::deviation(&out, surface, 0.25 * voxel);
         let kept = deviation <= bound;
-        if kept || tries == 3 {
+        if kept || tries >= most {
             return Within {
                 mesh: out,
-                stats: SimplifyStats { tolerance, ..stats },
+                stats: SimplifyStats {
+                    tolerance,
+                    seconds: start.elapsed().as_secs_f64(),
+                    ..stats
+                },
                 deviation,
                 kept,
             };
@@ -216,9 +228,9 @@ pub fn mesh_within(
         mesh,
         surface,
         voxel,
-        tolerance,
-        tolerance.max(uniform),
+        (tolerance, tolerance.max(uniform)),
         Some(mesh.volume()),
+        TRIES,
     );
     (
         w.mesh,
@@ -228,6 +240,7 @@ pub fn mesh_within(
             voxel,
             uniform_deviation: uniform,
             uniform_triangles: mesh.triangle_count() as u64,
+            auto: false,
         },
     )
 }

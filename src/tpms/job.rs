@@ -34,8 +34,8 @@ pub struct TpmsJob {
     pub resolution: u32,
     /// OpenVDB volumeToMesh adaptivity, 0 (uniform) to 1.
     pub adaptivity: f64,
-    /// Simplify the mesh within this distance of the exact surface, mm.
-    pub tolerance: Option<f64>,
+    /// Simplify the mesh within this distance of the exact surface.
+    pub tolerance: Option<crate::mesh::pipeline::Tolerance>,
     /// Build even if the solid falls apart into islands at this density.
     pub allow_islands: bool,
     /// Raise the resolution when sheet walls would be thinner than [`MIN_WALL_VOXELS`].
