@@ -943,36 +943,32 @@ fn simplify_part<S: Solid>(
 ) -> Result<(Mesh, Simplified)> {
     let volume = mesh.volume();
     let requested_triangles = mesh.triangle_count() as u64;
-    let deviation_on = |m: &Mesh, v: f64| {
-        let field = solid.field(&part_spec(solid, v));
+    let field_on = |used: f64| solid.field(&part_spec(solid, used));
+    let clip = solid.bounds();
+    let uniform = {
+        let field = field_on(voxel);
         let surface = Surface {
             field: &*field,
-            clip: solid.bounds(),
+            clip,
         };
-        simplify::deviation(m, surface, 0.25 * v)
+        simplify::deviation(&mesh, surface, 0.25 * voxel)
     };
-    let uniform = deviation_on(&mesh, voxel);
     let auto = tolerance == Tolerance::Auto;
     // The voxels to simplify on, in turn, and the tries on each: a tolerance in mm that the
     // uniform mesh nearly reaches is met on voxels that much finer (at most half the voxel: four
     // times the triangles to simplify); auto likewise where the uniform mesh's deviation sets it
     // (the volume's offset pushes the worst of its valleys out), else on the part's voxels and,
     // where no try keeps within it there, on voxels a little finer.
-    let (tolerance, voxels) = match tolerance {
-        Tolerance::Mm(t) if uniform > 0.9 * t => (
-            t,
-            vec![(voxel * (0.8 * t / uniform).max(0.5), simplify::TRIES)],
-        ),
-        Tolerance::Mm(t) => (t, vec![(voxel, simplify::TRIES)]),
-        Tolerance::Auto => {
-            let t = uniform.max(0.5 * voxel);
-            let finer = (0.8 * voxel, simplify::TRIES);
-            if uniform > 0.9 * t {
-                (t, vec![finer])
-            } else {
-                (t, vec![(voxel, simplify::TRIES), finer])
-            }
-        }
+    let tolerance = match tolerance {
+        Tolerance::Mm(t) => t,
+        Tolerance::Auto => uniform.max(0.5 * voxel),
+    };
+    let on = |scale: f64| (scale * voxel, simplify::TRIES);
+    let voxels = match (uniform > 0.9 * tolerance, auto) {
+        (true, false) => vec![on((0.8 * tolerance / uniform).max(0.5))],
+        (true, true) => vec![on(0.8)],
+        (false, false) => vec![on(1.0)],
+        (false, true) => vec![on(1.0), on(0.8)],
     };
     let report = |stats: SimplifyStats, deviation: f64, used: f64| Simplified {
         stats: SimplifyStats { tolerance, ..stats },
@@ -982,7 +978,6 @@ fn simplify_part<S: Solid>(
         uniform_triangles: requested_triangles,
         auto,
     };
-    let surface_on = |used: f64| solid.field(&part_spec(solid, used));
     let mut finer: Option<(Mesh, f64)> = None;
     for (used, tries) in voxels {
         if used != voxel {
@@ -993,10 +988,10 @@ fn simplify_part<S: Solid>(
             finer = Some((keyed.into_mesh(), used));
         }
         let base = finer.as_ref().map_or(&mesh, |f| &f.0);
-        let field = surface_on(used);
+        let field = field_on(used);
         let surface = Surface {
             field: &*field,
-            clip: solid.bounds(),
+            clip,
         };
         // Where the uniform mesh strays further than asked even so, those triangles stay as
         // they are and the rest is held to the tolerance (auto: the tolerance is that deviation
@@ -1027,10 +1022,10 @@ fn simplify_part<S: Solid>(
             return Ok((mesh, report(gave_up(n, 0.0), uniform, voxel)));
         }
     };
-    let field = surface_on(used);
+    let field = field_on(used);
     let surface = Surface {
         field: &*field,
-        clip: solid.bounds(),
+        clip,
     };
     let still = vec![false; base.vertex_count()];
     let offset = simplify::restore_volume(&mut base, surface, used, volume, &still);
